@@ -1,0 +1,465 @@
+/*
+ * lensprim.h -- a lens as ONE scene primitive for polarized ray tracing.
+ *
+ * A lens is a homogeneous isotropic glass volume bounded by two caps
+ * (spherical or flat) and an opaque rim (cylinder, or cone when the cap
+ * diameters differ).  lensprim turns one incoming linearly polarized ray
+ * into all its outgoing rays by Fresnel's equations at every node
+ * (forward, from the light), or builds the query rays of a view ray and
+ * gathers the bundles the application answers with (backward, from the
+ * eye).  The model is Debelov & Kushner, "Lens model to process linear
+ * polarized light"; where the paper and physics disagree, physics wins.
+ *
+ * CONVENTIONS (stated once, valid for the whole API)
+ *
+ *   Units        lengths in millimetres, vacuum wavelengths in nanometres,
+ *                angles and phases in radians, absorption in 1/mm.
+ *   Lens frame   local axis +z, front vertex at the origin, back vertex at
+ *                z = thickness.  The lens is placed in the world by the
+ *                world position of its front vertex and the world
+ *                direction of its local +z axis (a lens is rotationally
+ *                symmetric, so nothing else is needed).
+ *   Radii        optics sign convention: R > 0 means the centre of
+ *                curvature lies at +z of the vertex.  A biconvex lens has
+ *                radius1 > 0 and radius2 < 0.  0 or +-INFINITY is flat.
+ *   Indices      catalog indices are relative to air, so the default
+ *                surrounding medium is a constant n = 1 ("air").
+ *   Polarization a ray is fully linearly polarized: its electric field is
+ *                E = sqrt(I) * vp * exp(i*Phi) with the total phase
+ *                      Phi = 2*pi*op/lambda - pi*kphi + phase
+ *                (time dependence exp(-i*omega*t), so propagation adds
+ *                +2*pi*n*s/lambda).  Rays with the same `ch` are mutually
+ *                coherent and may be added as such complex amplitudes.
+ *   Phase jumps  a reflection adds 1 to kphi when the reflected field
+ *                points against the mirror image of the incident field
+ *                (Born & Wolf amplitudes).  For s light that is every
+ *                external reflection (n1 < n2) and no internal one; for p
+ *                light it is the paper's rule: n1 < n2 below Brewster's
+ *                angle, n1 > n2 above it.  Refraction keeps the phase.
+ *   TIR          beyond the critical angle s and p get different phase
+ *                shifts; the light becomes elliptical.  lensprim then
+ *                emits it as two coherent linear rays (part 0 and 1)
+ *                along the axes of the polarization ellipse, each with
+ *                its own `phase`.  Their amplitudes add to the exact field.
+ *   Depth        counts interface interactions along a path: the external
+ *                reflection has depth 1, a ray straight through depth 2.
+ *
+ * ERRORS
+ *
+ *   Functions that can fail return an lp_status (LP_OK == 0) and, when the
+ *   caller passes a non-NULL lp_error, fill it with the status and a
+ *   one-line message naming the problem.  The library never prints, never
+ *   exits and has no global mutable state.  A created lens is immutable:
+ *   any number of threads may trace through one const lp_lens at once,
+ *   each with its own lp_result / lp_backward.
+ */
+#ifndef LENSPRIM_H
+#define LENSPRIM_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32) && defined(LENSPRIM_SHARED)
+#  ifdef LENSPRIM_BUILDING
+#    define LP_API __declspec(dllexport)
+#  else
+#    define LP_API __declspec(dllimport)
+#  endif
+#elif defined(__GNUC__)
+#  define LP_API __attribute__((visibility("default")))
+#else
+#  define LP_API
+#endif
+
+#define LP_VERSION_MAJOR 0
+#define LP_VERSION_MINOR 1
+#define LP_VERSION_PATCH 0
+
+/* ------------------------------------------------------------------ */
+/* Status                                                              */
+/* ------------------------------------------------------------------ */
+
+typedef enum lp_status {
+    LP_OK = 0,
+    LP_ERROR_INVALID_ARGUMENT, /* NULL where not allowed, NaN, zero vector, ... */
+    LP_ERROR_INVALID_LENS,     /* a lens shape that cannot exist */
+    LP_ERROR_INVALID_GLASS,    /* a glass description that cannot be used */
+    LP_ERROR_UNKNOWN_GLASS,    /* no glass of that name in the catalog */
+    LP_ERROR_UNSUPPORTED,      /* e.g. an AGF dispersion formula not implemented */
+    LP_ERROR_PARSE,            /* malformed catalog text */
+    LP_ERROR_IO,               /* a file could not be read */
+    LP_ERROR_NO_MEMORY,
+    LP_ERROR_RANGE             /* an index out of range */
+} lp_status;
+
+/* A status and a message.  message is always NUL-terminated. */
+typedef struct lp_error {
+    lp_status status;
+    char message[256];
+} lp_error;
+
+/* A static English string for a status; never NULL (unknown codes give
+ * "unknown status"). */
+LP_API const char *lp_status_string(lp_status status);
+
+/* ------------------------------------------------------------------ */
+/* Small values                                                        */
+/* ------------------------------------------------------------------ */
+
+typedef struct lp_vec3 {
+    double x, y, z;
+} lp_vec3;
+
+/* ------------------------------------------------------------------ */
+/* Glass                                                               */
+/* ------------------------------------------------------------------ */
+
+/* Dispersion formulas.  lambda below is in MICROMETRES, as glass makers
+ * publish the coefficients; the API takes nanometres and converts.
+ *   CONSTANT   n = coef[0]
+ *   SELLMEIER  n^2 = 1 + sum_{k=0..2} coef[k]*l^2 / (l^2 - coef[3+k])
+ *              (Schott form: B1 B2 B3 C1 C2 C3, C in um^2)
+ *   SCHOTT     n^2 = a0 + a1 l^2 + a2 l^-2 + a3 l^-4 + a4 l^-6 + a5 l^-8
+ *   CAUCHY     n = A + B/l^2 + C/l^4                      (coef A B C)
+ *   CONRADY    n = n0 + A/l + B/l^3.5                     (coef n0 A B) */
+typedef enum lp_formula {
+    LP_FORMULA_CONSTANT = 0,
+    LP_FORMULA_SELLMEIER,
+    LP_FORMULA_SCHOTT,
+    LP_FORMULA_CAUCHY,
+    LP_FORMULA_CONRADY,
+    LP_FORMULA_UNSUPPORTED /* read from a catalog, cannot be evaluated */
+} lp_formula;
+
+#define LP_GLASS_NAME_MAX 32
+#define LP_GLASS_TABLE_MAX 48
+
+/* A glass is plain data: n(lambda) by a formula and the internal
+ * transmittance tau(lambda) of a sample of thickness tau_thickness_mm,
+ * which gives the absorption coefficient alpha = -ln(tau)/thickness.
+ * n_tau == 0 means no absorption.  lambda_min_nm/lambda_max_nm is the
+ * range where the maker's data hold (0, 0: unbounded); outside it the
+ * formula is extrapolated and traces report LP_WARN_EXTRAPOLATED. */
+typedef struct lp_glass {
+    char name[LP_GLASS_NAME_MAX];
+    lp_formula formula;
+    int agf_formula;          /* the AGF formula number it came from, or 0 */
+    double coef[10];
+    double lambda_min_nm, lambda_max_nm;
+    int n_tau;
+    double tau_lambda_nm[LP_GLASS_TABLE_MAX]; /* strictly increasing */
+    double tau[LP_GLASS_TABLE_MAX];           /* in (0, 1] */
+    double tau_thickness_mm;
+} lp_glass;
+
+/* Fill *glass with a constant, lossless index n (named "n=<n>"). */
+LP_API void lp_glass_init_constant(lp_glass *glass, double n);
+
+/* Fill *glass with a lossless 3-term Sellmeier glass (Schott form, C in
+ * um^2), valid over 380-780 nm unless the caller widens the range. */
+LP_API void lp_glass_init_sellmeier(lp_glass *glass, const char *name,
+                                    const double b[3], const double c[3]);
+
+/* Check that a glass can be used: a supported formula, finite
+ * coefficients, n >= 1e-3 and finite over its range (380-780 nm when the
+ * range is unbounded), a valid transmittance table. */
+LP_API lp_status lp_glass_check(const lp_glass *glass, lp_error *err);
+
+/* Refractive index at a vacuum wavelength; NaN for an unsupported formula
+ * or a wavelength <= 0.  No range check: see lp_glass_covers. */
+LP_API double lp_glass_index(const lp_glass *glass, double lambda_nm);
+
+/* Absorption coefficient alpha(lambda) in 1/mm (0 for no table).  The
+ * table is interpolated linearly in ln(tau) and held constant past its
+ * ends. */
+LP_API double lp_glass_absorption(const lp_glass *glass, double lambda_nm);
+
+/* 1 when lambda_nm lies inside the glass's data range (or the range is
+ * unbounded), else 0. */
+LP_API int lp_glass_covers(const lp_glass *glass, double lambda_nm);
+
+/* Copy the built-in catalog glass `name` (case-insensitive; e.g. "N-BK7",
+ * "N-SF11", "F2", "N-BAK4", "N-SF6", "FUSED-SILICA", "CAF2") into *out. */
+LP_API lp_status lp_glass_builtin(const char *name, lp_glass *out,
+                                  lp_error *err);
+
+/* A catalog: the built-in glasses plus any loaded from Zemax AGF files. */
+typedef struct lp_catalog lp_catalog;
+
+LP_API lp_status lp_catalog_create(lp_catalog **out, lp_error *err);
+LP_API void lp_catalog_destroy(lp_catalog *catalog); /* NULL: no-op */
+
+/* Load glasses from an AGF file (NM, CD, LD, IT lines are read; ED, TD,
+ * OD, GC, CC, BD lines are skipped).  UTF-8/ASCII and UTF-16 (with BOM)
+ * files are accepted.  A later glass of the same name replaces an earlier
+ * one.  On error nothing is added. */
+LP_API lp_status lp_catalog_load_agf(lp_catalog *catalog, const char *path,
+                                     lp_error *err);
+/* The same from text in memory (len bytes). */
+LP_API lp_status lp_catalog_load_agf_text(lp_catalog *catalog,
+                                          const char *text, size_t len,
+                                          lp_error *err);
+
+/* Find a glass by name (case-insensitive).  LP_ERROR_UNKNOWN_GLASS if
+ * absent; LP_ERROR_UNSUPPORTED if its dispersion formula cannot be
+ * evaluated. */
+LP_API lp_status lp_catalog_find(const lp_catalog *catalog, const char *name,
+                                 lp_glass *out, lp_error *err);
+
+LP_API size_t lp_catalog_count(const lp_catalog *catalog);
+/* The name of glass i (0 <= i < count), or NULL. */
+LP_API const char *lp_catalog_name(const lp_catalog *catalog, size_t i);
+
+/* ------------------------------------------------------------------ */
+/* Lens                                                                */
+/* ------------------------------------------------------------------ */
+
+typedef struct lp_lens lp_lens;
+
+typedef struct lp_lens_desc {
+    double radius1;    /* front surface radius, mm; 0 or +-inf = flat */
+    double radius2;    /* back surface radius, mm */
+    double thickness;  /* centre thickness, mm, > 0 */
+    double diameter;   /* rim diameter at the front cap, mm, > 0 */
+    double diameter2;  /* rim diameter at the back cap; 0 = diameter */
+    lp_glass glass;
+    lp_glass medium;   /* surrounding medium; default constant 1 (air) */
+    lp_vec3 position;  /* world position of the front vertex */
+    lp_vec3 axis;      /* world direction of the local +z axis */
+} lp_lens_desc;
+
+/* Defaults: flat surfaces, thickness 0 (must be set), diameter 0 (must be
+ * set), glass constant 1.5, medium constant 1, at the origin, axis +z. */
+LP_API void lp_lens_desc_init(lp_lens_desc *desc);
+
+/* Create an immutable lens.  Refused with LP_ERROR_INVALID_LENS and a
+ * message naming the problem: a non-finite number, thickness <= 0,
+ * diameter <= 0, a cap wider than its sphere (D/2 > |R|), caps that cross
+ * before the rim (negative edge thickness), a conical rim between caps
+ * that meet (knife edge with D != D2), a zero axis.  A knife-edge lens
+ * (edge thickness 0, D2 == D) has no rim. *out is NULL on error. */
+LP_API lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out,
+                                lp_error *err);
+LP_API void lp_lens_destroy(lp_lens *lens); /* NULL: no-op */
+
+/* The description the lens was created from (axis normalized). */
+LP_API void lp_lens_get_desc(const lp_lens *lens, lp_lens_desc *out);
+
+/* Edge (rim) thickness along the rim, mm; 0 for a knife edge. */
+LP_API double lp_lens_edge_thickness(const lp_lens *lens);
+
+/* World-space axis-aligned bounding box. */
+LP_API void lp_lens_bounds(const lp_lens *lens, lp_vec3 *lo, lp_vec3 *hi);
+
+enum {
+    LP_SURFACE_NONE = -1,
+    LP_SURFACE_FRONT = 0,
+    LP_SURFACE_BACK = 1,
+    LP_SURFACE_RIM = 2
+};
+
+typedef struct lp_hit {
+    double t;        /* distance along the unit direction */
+    lp_vec3 point;   /* world */
+    lp_vec3 normal;  /* world, unit, pointing out of the glass */
+    int surface;     /* LP_SURFACE_* */
+} lp_hit;
+
+/* Nearest intersection of the world ray origin + t*dir with the lens
+ * surface, t in (t_min, t_max).  dir is normalized first, so t is a
+ * distance in mm.  Returns 1 and fills *hit, or 0 when there is none or
+ * the input is not finite. */
+LP_API int lp_lens_intersect(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir,
+                             double t_min, double t_max, lp_hit *hit);
+
+/* 1 if the world point lies inside the glass (boundary excluded). */
+LP_API int lp_lens_contains(const lp_lens *lens, lp_vec3 point);
+
+/* ------------------------------------------------------------------ */
+/* Rays and tracing                                                    */
+/* ------------------------------------------------------------------ */
+
+/* A ray with its payload <lambda, I, vp, kphi, op, ch> (+ phase). */
+typedef struct lp_ray {
+    lp_vec3 origin;
+    lp_vec3 dir;        /* unit */
+    double lambda_nm;   /* vacuum wavelength */
+    double intensity;   /* power carried, >= 0 */
+    lp_vec3 vp;         /* unit field direction, perpendicular to dir */
+    int kphi;           /* phase jumps by pi */
+    double op;          /* optical path, mm (sum of n*s) */
+    double phase;       /* extra phase, rad (non-zero after TIR) */
+    uint64_t ch;        /* source id, copied, never interpreted */
+} lp_ray;
+
+typedef enum lp_kind {
+    LP_KIND_REFLECT = 0,  /* left on the side the light came from */
+    LP_KIND_TRANSMIT = 1  /* left on the other side */
+} lp_kind;
+
+/* One outgoing ray. */
+typedef struct lp_out_ray {
+    lp_ray ray;       /* origin on the lens surface, dir pointing away */
+    int depth;        /* interface interactions along the path, >= 1 */
+    lp_kind kind;
+    int surface;      /* LP_SURFACE_FRONT or LP_SURFACE_BACK */
+    int part;         /* 0, or 1 for the second linear part after TIR */
+    uint64_t path;    /* bit k-1 set when node k was a reflection */
+} lp_out_ray;
+
+/* Warnings a trace can raise (bits of lp_result.warnings). */
+enum {
+    LP_WARN_EXTRAPOLATED = 1u << 0, /* lambda outside a glass's data range */
+    LP_WARN_LEAK = 1u << 1          /* an internal ray found no surface
+                                       (numerical); its energy was counted
+                                       as absorbed at the rim */
+};
+
+/* The outgoing rays of a trace and its energy bookkeeping:
+ *   in = out + skipped + absorbed_glass + absorbed_rim + truncated
+ * to rounding.  `truncated` is the energy left inside at depth max_depth
+ * or in branches cut below min_weight; `skipped` is the energy of
+ * outgoing rays the filter or flags declined.  The rays array is owned by
+ * the result and reused by later calls. */
+typedef struct lp_result {
+    lp_out_ray *rays;
+    size_t count;
+    size_t capacity;
+    double in, out, skipped, absorbed_glass, absorbed_rim, truncated;
+    unsigned warnings;
+} lp_result;
+
+LP_API void lp_result_init(lp_result *result);
+/* Forget the rays and zero the bookkeeping; keep the memory. */
+LP_API void lp_result_clear(lp_result *result);
+/* Free the memory; the result may be initialized again. NULL: no-op. */
+LP_API void lp_result_release(lp_result *result);
+
+typedef enum lp_mode {
+    LP_MODE_POLARIZED = 0, /* transformation G: s/p amplitudes, vp, phase */
+    LP_MODE_FRESNEL,       /* unpolarized: R = (Rs + Rp)/2 per node */
+    LP_MODE_SCHLICK        /* unpolarized: R0 + (1-R0)(1-cos)^5, with
+                              cos of the transmitted angle when n1 > n2 */
+} lp_mode;
+
+/* What the filter callback is told about a candidate outgoing ray
+ * (forward: an outgoing ray; backward: a query ray). */
+typedef struct lp_branch_info {
+    int depth;
+    lp_kind kind;
+    int surface;
+    lp_vec3 origin;   /* world */
+    lp_vec3 dir;      /* world, unit, pointing away from the lens */
+    double bound;     /* forward: the ray's intensity; backward: an upper
+                         bound of the path's power transmittance */
+} lp_branch_info;
+
+/* Return nonzero to keep the ray, 0 to skip it. */
+typedef int (*lp_filter_fn)(const lp_branch_info *info, void *user);
+
+enum {
+    LP_SKIP_EXTERNAL_REFLECTION = 1u << 0, /* drop the depth-1 reflection */
+    LP_SKIP_REFLECTED = 1u << 1            /* drop every ray leaving on the
+                                              incoming side */
+};
+
+#define LP_MAX_DEPTH 64
+
+typedef struct lp_trace_args {
+    lp_mode mode;
+    int max_depth;        /* dT, 1..LP_MAX_DEPTH; default 5 */
+    double min_weight;    /* cut an internal branch when its power relative
+                             to the input (forward) or its bound (backward)
+                             falls below this; default 0 = never */
+    unsigned flags;       /* LP_SKIP_* */
+    lp_filter_fn filter;  /* optional */
+    void *user;           /* passed to filter */
+} lp_trace_args;
+
+LP_API void lp_trace_args_init(lp_trace_args *args);
+
+/* Forward trace (from the light).  `in` is a world ray with a full
+ * payload; vp is made perpendicular to dir and normalized (a vp parallel
+ * to dir is an error), dir is normalized.  The result is cleared first,
+ * then filled with every outgoing ray up to depth max_depth and the
+ * bookkeeping.  A ray that misses the lens gives no rays and all the
+ * bookkeeping zero (the lens received nothing).  args NULL: defaults. */
+LP_API lp_status lp_trace_forward(const lp_lens *lens, const lp_ray *in,
+                                  const lp_trace_args *args, lp_result *out,
+                                  lp_error *err);
+
+/* Many rays at once: the results of ray i are out->rays[offsets[i] ..
+ * offsets[i+1]) and the bookkeeping is summed over all rays.  offsets has
+ * n + 1 entries.  Stops at the first invalid ray (its index is in the
+ * message). */
+LP_API lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in,
+                                       size_t n, const lp_trace_args *args,
+                                       lp_result *out, size_t *offsets,
+                                       lp_error *err);
+
+/* ------------------------------------------------------------------ */
+/* Backward tracing (from the eye), in two phases                      */
+/* ------------------------------------------------------------------ */
+
+/* A query ray: the application traces it into the scene and answers
+ * with a bundle of linearly polarized rays arriving back along it. */
+typedef struct lp_query {
+    lp_vec3 origin;   /* world, on the lens surface */
+    lp_vec3 dir;      /* world, unit, pointing away from the lens */
+    int depth;        /* depth of the path, >= 1 */
+    lp_kind kind;     /* REFLECT: leaves on the viewer's side */
+    int surface;
+    uint64_t path;
+    double op;        /* optical path inside the lens along this path */
+    double bound;     /* upper bound of the power transmittance of the path
+                         for any polarization: prod max(Rs,Rp)|max(Ts,Tp)
+                         times absorption.  For fresnel/schlick modes it is
+                         the exact transmittance. */
+    double weight;    /* unpolarized transmittance estimate: the fresnel
+                         (or schlick) product along the path */
+} lp_query;
+
+typedef struct lp_backward lp_backward;
+
+LP_API lp_status lp_backward_create(lp_backward **out, lp_error *err);
+LP_API void lp_backward_destroy(lp_backward *bw); /* NULL: no-op */
+
+/* Phase 1, build.  The view ray carries only lambda.  Builds the internal
+ * chain and the query rays (filtered by args->flags, args->filter and
+ * args->min_weight against `bound`).  Replaces what bw held before.  A
+ * ray that misses the lens yields no queries and LP_OK. */
+LP_API lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens,
+                                   lp_vec3 origin, lp_vec3 dir,
+                                   double lambda_nm, const lp_trace_args *args,
+                                   lp_error *err);
+
+LP_API size_t lp_backward_query_count(const lp_backward *bw);
+/* The query rays, count of them; valid until the next build. */
+LP_API const lp_query *lp_backward_queries(const lp_backward *bw);
+
+/* Depth at which the view ray's chain met the rim (1 = the view ray hit
+ * the rim itself), or 0 if it did not (within max_depth). */
+LP_API int lp_backward_rim_depth(const lp_backward *bw);
+
+/* Phase 2, gather.  bundle[0..n) are linearly polarized rays arriving
+ * back along query q (their origin and dir are ignored: they travel along
+ * -query.dir).  Each is carried through the path's nodes in the direction
+ * of light and APPENDED to out as a ray leaving the lens at the view
+ * ray's entry point along -view dir, with depth/kind/path of the query,
+ * op and kphi added to the bundle ray's own, ch copied.  Not merged:
+ * one or two (after TIR) output rays per bundle ray.  out->in gains the
+ * bundle's intensity, out->out the output, out->absorbed_glass the
+ * absorption, out->truncated what the path's nodes sent elsewhere. */
+LP_API lp_status lp_backward_gather(const lp_backward *bw, size_t q,
+                                    const lp_ray *bundle, size_t n,
+                                    lp_result *out, lp_error *err);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LENSPRIM_H */

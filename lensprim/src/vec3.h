@@ -1,0 +1,42 @@
+/* vec3.h -- small 3-vector helpers, by value (internal).
+ * Conventions: doubles, right-handed arithmetic; handedness of the scene
+ * never enters here. */
+#ifndef LP_VEC3_H
+#define LP_VEC3_H
+
+#include <math.h>
+#include "lensprim.h"
+
+static inline lp_vec3 v3(double x, double y, double z) { lp_vec3 v = {x, y, z}; return v; }
+static inline lp_vec3 v3_add(lp_vec3 a, lp_vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline lp_vec3 v3_sub(lp_vec3 a, lp_vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline lp_vec3 v3_scale(lp_vec3 a, double s) { return v3(a.x * s, a.y * s, a.z * s); }
+static inline lp_vec3 v3_neg(lp_vec3 a) { return v3(-a.x, -a.y, -a.z); }
+static inline double v3_dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline lp_vec3 v3_cross(lp_vec3 a, lp_vec3 b)
+{
+    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline double v3_len(lp_vec3 a) { return sqrt(v3_dot(a, a)); }
+/* a + s*b */
+static inline lp_vec3 v3_madd(lp_vec3 a, lp_vec3 b, double s)
+{
+    return v3(a.x + s * b.x, a.y + s * b.y, a.z + s * b.z);
+}
+static inline int v3_finite(lp_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+/* Unit vector along a; a zero or non-finite a gives (0,0,0). */
+static inline lp_vec3 v3_normalize(lp_vec3 a)
+{
+    double l = v3_len(a);
+    if (!(l > 0.0) || !isfinite(l))
+        return v3(0.0, 0.0, 0.0);
+    return v3_scale(a, 1.0 / l);
+}
+/* Any unit vector perpendicular to the unit vector a (deterministic). */
+static inline lp_vec3 v3_any_perp(lp_vec3 a)
+{
+    lp_vec3 h = fabs(a.x) < 0.6 ? v3(1, 0, 0) : (fabs(a.y) < 0.6 ? v3(0, 1, 0) : v3(0, 0, 1));
+    return v3_normalize(v3_cross(a, h));
+}
+
+#endif
