@@ -7,6 +7,8 @@
 #include <math.h>
 #include "lensprim.h"
 
+#define LP_PI 3.14159265358979323846
+
 static inline lp_vec3 v3(double x, double y, double z) { lp_vec3 v = {x, y, z}; return v; }
 static inline lp_vec3 v3_add(lp_vec3 a, lp_vec3 b) { return v3(a.x + b.x, a.y + b.y, a.z + b.z); }
 static inline lp_vec3 v3_sub(lp_vec3 a, lp_vec3 b) { return v3(a.x - b.x, a.y - b.y, a.z - b.z); }

@@ -1,0 +1,54 @@
+/* interface.h -- the transformation G at one interface crossing (internal).
+ *
+ * A beam is a power-normalized complex field E (|E|^2 = power, E
+ * perpendicular to the direction).  In polarized mode G splits E into s
+ * and p, applies Fresnel's amplitudes (fresnel.h) and rebuilds the
+ * reflected and transmitted fields on their own s/p axes.  A reflection
+ * whose field points against the mirror image of the incident field is
+ * reported as a phase jump (flip = 1) and the field is negated, so that
+ * E * (-1)^kphi stays the physical field.  In the unpolarized modes the
+ * field only carries a direction for v_p: its power is scaled by R or
+ * 1 - R of the mode's law and its direction is mirrored or carried over
+ * on the s/p axes. */
+#ifndef LP_INTERFACE_H
+#define LP_INTERFACE_H
+
+#include "cvec3.h"
+#include "fresnel.h"
+#include "lensprim.h"
+
+typedef struct lp__branch {
+    lp_vec3 dir;   /* unit */
+    lp__cvec3 E;
+    int flip;      /* a phase jump by pi was counted */
+} lp__branch;
+
+/* Geometry and Fresnel factors of one node, shared by both branches. */
+typedef struct lp__node {
+    lp_vec3 d;        /* incident direction */
+    lp_vec3 n;        /* unit normal facing the incident side */
+    double cos_i;
+    lp__fresnel f;
+    lp_vec3 s;        /* unit s axis */
+    double n1, n2;    /* indices before and after the boundary */
+} lp__node;
+
+/* Set up a node: light along unit d meets a surface with unit normal
+ * `normal` (either orientation) going from index n1 into n2.  hint is a
+ * field to take the s axis from at normal incidence (the s/p split is
+ * undefined there; any axis gives the same result, the incoming field's
+ * own keeps the frame).  Returns 1 under total internal reflection. */
+int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
+                   const lp__cvec3 *hint);
+
+/* The reflected branch of G for field E in the given mode. */
+void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp__branch *out);
+/* The transmitted branch (not under TIR). */
+void lp__node_transmit(const lp__node *node, lp_mode mode, const lp__cvec3 *E,
+                       lp__branch *out);
+
+/* Power reflectance of the node in an unpolarized mode (fresnel or
+ * schlick); 1 under TIR. */
+double lp__node_reflectance(const lp__node *node, lp_mode mode);
+
+#endif

@@ -1,0 +1,285 @@
+/* lens.c -- creating, validating and intersecting a lens. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "error.h"
+#include "lens_internal.h"
+#include "vec3.h"
+
+void lp_lens_desc_init(lp_lens_desc *desc)
+{
+    if (!desc)
+        return;
+    memset(desc, 0, sizeof *desc);
+    lp_glass_init_constant(&desc->glass, 1.5);
+    lp_glass_init_constant(&desc->medium, 1.0);
+    desc->axis = v3(0.0, 0.0, 1.0);
+}
+
+/* Curvature of a radius: 0 and +-inf are flat. */
+static double curvature(double r)
+{
+    if (r == 0.0 || isinf(r))
+        return 0.0;
+    return 1.0 / r;
+}
+
+static lp_status check_shape(const lp_lens_desc *d, lp_error *err)
+{
+    if (isnan(d->radius1) || isnan(d->radius2))
+        return lp__fail(err, LP_ERROR_INVALID_LENS, "radius %s is NaN",
+                        isnan(d->radius1) ? "R1" : "R2");
+    if (!isfinite(d->thickness))
+        return lp__fail(err, LP_ERROR_INVALID_LENS, "thickness is not a finite number");
+    if (!(d->thickness > 0.0))
+        return lp__fail(err, LP_ERROR_INVALID_LENS, "thickness %g mm must be > 0",
+                        d->thickness);
+    if (!isfinite(d->diameter) || !(d->diameter > 0.0))
+        return lp__fail(err, LP_ERROR_INVALID_LENS, "diameter D=%g mm must be a finite number > 0",
+                        d->diameter);
+    if (!isfinite(d->diameter2) || d->diameter2 < 0.0)
+        return lp__fail(err, LP_ERROR_INVALID_LENS,
+                        "diameter D2=%g mm must be a finite number > 0 (or 0 for D2 = D)",
+                        d->diameter2);
+    if (!v3_finite(d->position))
+        return lp__fail(err, LP_ERROR_INVALID_LENS, "lens position is not finite");
+    if (!v3_finite(d->axis) || !(v3_len(d->axis) > 0.0))
+        return lp__fail(err, LP_ERROR_INVALID_LENS, "lens axis must be a finite non-zero vector");
+    return LP_OK;
+}
+
+lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
+{
+    lp_status st;
+    lp_lens *lens;
+
+    if (out)
+        *out = NULL;
+    if (!desc || !out)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_lens_create: NULL argument");
+    if ((st = check_shape(desc, err)) != LP_OK)
+        return st;
+    if ((st = lp_glass_check(&desc->glass, err)) != LP_OK)
+        return st;
+    if ((st = lp_glass_check(&desc->medium, err)) != LP_OK)
+        return st;
+
+    double c1 = curvature(desc->radius1), c2 = curvature(desc->radius2);
+    double t = desc->thickness;
+    double h1 = 0.5 * desc->diameter;
+    double h2 = 0.5 * (desc->diameter2 > 0.0 ? desc->diameter2 : desc->diameter);
+
+    if (c1 != 0.0 && h1 > fabs(desc->radius1))
+        return lp__fail(err, LP_ERROR_INVALID_LENS,
+                        "front cap diameter %g mm is wider than its sphere (|R1| = %g mm)",
+                        2.0 * h1, fabs(desc->radius1));
+    if (c2 != 0.0 && h2 > fabs(desc->radius2))
+        return lp__fail(err, LP_ERROR_INVALID_LENS,
+                        "back cap diameter %g mm is wider than its sphere (|R2| = %g mm)",
+                        2.0 * h2, fabs(desc->radius2));
+
+    double scale = fmax(t, fmax(2.0 * h1, 2.0 * h2));
+    double tol = 1e-12 * scale;
+    /* The axial thickness T(r) = t + sag2(r) - sag1(r) is monotonic in r
+     * (its derivative has the sign of c2 - c1), so checking the smaller
+     * aperture's edge covers the whole common aperture. */
+    double hmin = fmin(h1, h2);
+    double t_at_hmin = t + lp__cap_sag(c2, hmin) - lp__cap_sag(c1, hmin);
+    if (t_at_hmin < -tol)
+        return lp__fail(err, LP_ERROR_INVALID_LENS,
+                        "the caps cross before the rim: thickness at r = %g mm is %g mm",
+                        hmin, t_at_hmin);
+    double z1e = lp__cap_sag(c1, h1);
+    double z2e = t + lp__cap_sag(c2, h2);
+    double edge = z2e - z1e;
+
+    lens = calloc(1, sizeof *lens);
+    if (!lens)
+        return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory creating a lens");
+    lens->desc = *desc;
+    lens->desc.diameter2 = 2.0 * h2;
+    lens->cap[LP_SURFACE_FRONT] = (lp__cap){c1, 0.0, h1, +1.0};
+    lens->cap[LP_SURFACE_BACK] = (lp__cap){c2, t, h2, -1.0};
+
+    if (h1 == h2) {
+        if (edge < -tol) {
+            free(lens);
+            return lp__fail(err, LP_ERROR_INVALID_LENS,
+                            "the caps cross before the rim: edge thickness %g mm", edge);
+        }
+        if (edge > tol) {
+            lens->rim = (lp__rim){1, z1e, h1, z2e, h2, 0.0};
+        } else {
+            lens->rim.present = 0; /* knife edge */
+        }
+    } else {
+        if (!(edge > tol)) {
+            free(lens);
+            return lp__fail(err, LP_ERROR_INVALID_LENS,
+                            "a conical rim (D2 != D) needs a positive edge thickness, got %g mm",
+                            edge);
+        }
+        lens->rim = (lp__rim){1, z1e, h1, z2e, h2, (h2 - h1) / edge};
+        /* The cone must stay behind the wider cap between the two edges. */
+        for (int i = 1; i < 64; i++) {
+            double f = i / 64.0;
+            double r = h1 + f * (h2 - h1);
+            double zc = z1e + f * edge;
+            int bad = h1 > h2 ? zc < lp__cap_sag(c1, r) - tol
+                              : zc > t + lp__cap_sag(c2, r) + tol;
+            if (bad) {
+                free(lens);
+                return lp__fail(err, LP_ERROR_INVALID_LENS,
+                                "the conical rim cuts through the %s cap at r = %g mm",
+                                h1 > h2 ? "front" : "back", r);
+            }
+        }
+    }
+
+    lens->z_min = fmin(0.0, fmin(z1e, z2e));
+    lens->z_max = fmax(t, fmax(z1e, z2e));
+    lens->h_max = fmax(h1, h2);
+    lens->scale = fmax(scale, lens->z_max - lens->z_min);
+    lens->eps = 1e-12 * lens->scale;
+
+    lens->w = v3_normalize(desc->axis);
+    lens->desc.axis = lens->w;
+    lens->u = v3_any_perp(lens->w);
+    lens->v = v3_cross(lens->w, lens->u);
+    *out = lens;
+    lp__ok(err);
+    return LP_OK;
+}
+
+void lp_lens_destroy(lp_lens *lens)
+{
+    free(lens);
+}
+
+void lp_lens_get_desc(const lp_lens *lens, lp_lens_desc *out)
+{
+    if (lens && out)
+        *out = lens->desc;
+}
+
+double lp_lens_edge_thickness(const lp_lens *lens)
+{
+    if (!lens)
+        return NAN;
+    return lens->rim.present ? lens->rim.z_b - lens->rim.z_a : 0.0;
+}
+
+lp_vec3 lp__to_local_point(const lp_lens *lens, lp_vec3 p)
+{
+    lp_vec3 q = v3_sub(p, lens->desc.position);
+    return v3(v3_dot(q, lens->u), v3_dot(q, lens->v), v3_dot(q, lens->w));
+}
+
+lp_vec3 lp__to_local_dir(const lp_lens *lens, lp_vec3 d)
+{
+    return v3(v3_dot(d, lens->u), v3_dot(d, lens->v), v3_dot(d, lens->w));
+}
+
+lp_vec3 lp__to_world_dir(const lp_lens *lens, lp_vec3 d)
+{
+    return v3_add(v3_add(v3_scale(lens->u, d.x), v3_scale(lens->v, d.y)), v3_scale(lens->w, d.z));
+}
+
+lp_vec3 lp__to_world_point(const lp_lens *lens, lp_vec3 p)
+{
+    return v3_add(lens->desc.position, lp__to_world_dir(lens, p));
+}
+
+void lp_lens_bounds(const lp_lens *lens, lp_vec3 *lo, lp_vec3 *hi)
+{
+    lp_vec3 a = v3(INFINITY, INFINITY, INFINITY), b = v3(-INFINITY, -INFINITY, -INFINITY);
+    if (!lens)
+        return;
+    for (int i = 0; i < 8; i++) {
+        lp_vec3 c = v3(i & 1 ? lens->h_max : -lens->h_max, i & 2 ? lens->h_max : -lens->h_max,
+                       i & 4 ? lens->z_max : lens->z_min);
+        lp_vec3 w = lp__to_world_point(lens, c);
+        a = v3(fmin(a.x, w.x), fmin(a.y, w.y), fmin(a.z, w.z));
+        b = v3(fmax(b.x, w.x), fmax(b.y, w.y), fmax(b.z, w.z));
+    }
+    if (lo)
+        *lo = a;
+    if (hi)
+        *hi = b;
+}
+
+int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
+                 double t_min, double t_max, lp__local_hit *hit)
+{
+    double best = t_max, t;
+    int surface = LP_SURFACE_NONE;
+
+    for (int s = LP_SURFACE_FRONT; s <= LP_SURFACE_BACK; s++) {
+        int self = s == from_surface;
+        double tmin = self ? t_min : fmax(t_min, from_surface == LP_SURFACE_NONE ? t_min : lens->eps);
+        if (lp__cap_intersect(&lens->cap[s], p, d, self, tmin, best, &t)) {
+            best = t;
+            surface = s;
+        }
+    }
+    double tmin_rim = from_surface == LP_SURFACE_NONE ? t_min : fmax(t_min, lens->eps);
+    if (lp__rim_intersect(&lens->rim, p, d, tmin_rim, best, &t)) {
+        best = t;
+        surface = LP_SURFACE_RIM;
+    }
+    if (surface == LP_SURFACE_NONE)
+        return 0;
+    hit->t = best;
+    hit->p = v3_madd(p, d, best);
+    hit->surface = surface;
+    hit->n = surface == LP_SURFACE_RIM ? lp__rim_normal(&lens->rim, hit->p)
+                                       : lp__cap_normal(&lens->cap[surface], hit->p);
+    return 1;
+}
+
+int lp_lens_intersect(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir, double t_min,
+                      double t_max, lp_hit *hit)
+{
+    lp__local_hit h;
+    if (!lens || !hit || !v3_finite(origin) || !v3_finite(dir) || isnan(t_min) || isnan(t_max))
+        return 0;
+    lp_vec3 d = v3_normalize(dir);
+    if (d.x == 0.0 && d.y == 0.0 && d.z == 0.0)
+        return 0;
+    if (!lp__lens_hit(lens, lp__to_local_point(lens, origin), lp__to_local_dir(lens, d),
+                      LP_SURFACE_NONE, t_min, t_max, &h))
+        return 0;
+    hit->t = h.t;
+    hit->point = v3_madd(origin, d, h.t);
+    hit->normal = lp__to_world_dir(lens, h.n);
+    hit->surface = h.surface;
+    return 1;
+}
+
+int lp_lens_contains(const lp_lens *lens, lp_vec3 point)
+{
+    if (!lens || !v3_finite(point))
+        return 0;
+    lp_vec3 p = lp__to_local_point(lens, point);
+    if (!(p.z > lens->z_min && p.z < lens->z_max))
+        return 0;
+    double r2 = p.x * p.x + p.y * p.y;
+    const lp__cap *f = &lens->cap[LP_SURFACE_FRONT], *b = &lens->cap[LP_SURFACE_BACK];
+    /* behind the front cap: c1(r^2 + z^2) - 2z < 0; before the back cap:
+     * c2(r^2 + (z-t)^2) - 2(z-t) > 0 */
+    if (!(f->c * (r2 + p.z * p.z) - 2.0 * p.z < 0.0))
+        return 0;
+    double zb = p.z - b->z0;
+    if (!(b->c * (r2 + zb * zb) - 2.0 * zb > 0.0))
+        return 0;
+    double rho;
+    if (lens->rim.present) {
+        const lp__rim *rim = &lens->rim;
+        rho = rim->rho_a + rim->k * (p.z - rim->z_a);
+        rho = fmin(rho, lens->h_max);
+    } else {
+        rho = f->h;
+    }
+    return r2 < rho * rho;
+}

@@ -1,0 +1,76 @@
+/* lens_internal.h -- the lens object and its surfaces (internal).
+ *
+ * Local frame: axis +z, front vertex at z = 0, back vertex at z = t.
+ * A cap is the Spencer & Murty surface c(x^2 + y^2 + (z-z0)^2) - 2(z-z0) = 0
+ * through its vertex (0,0,z0), cut to x^2 + y^2 <= h^2 on the branch
+ * c(z - z0) <= 1 next to the vertex; c = 0 is the plane z = z0 with no
+ * special case.  The rim is x^2 + y^2 = rho(z)^2 with rho linear in z
+ * between the two cap edges (a cylinder when both apertures are equal). */
+#ifndef LP_LENS_INTERNAL_H
+#define LP_LENS_INTERNAL_H
+
+#include "lensprim.h"
+
+typedef struct lp__cap {
+    double c;       /* curvature 1/R, 0 for flat */
+    double z0;      /* vertex z */
+    double h;       /* aperture radius */
+    double out;     /* +1: outward normal is (cx, cy, c(z-z0) - 1) (front);
+                       -1: its opposite (back) */
+} lp__cap;
+
+typedef struct lp__rim {
+    int present;    /* 0 for a knife-edge lens */
+    double z_a, rho_a; /* one edge circle */
+    double z_b, rho_b; /* the other; z_a < z_b */
+    double k;          /* d rho / d z */
+} lp__rim;
+
+struct lp_lens {
+    lp_lens_desc desc;
+    lp__cap cap[2];   /* LP_SURFACE_FRONT, LP_SURFACE_BACK */
+    lp__rim rim;
+    lp_vec3 u, v, w;  /* world directions of local x, y, z */
+    double z_min, z_max, h_max; /* local bounding cylinder */
+    double scale;     /* a size of the lens, mm */
+    double eps;       /* distance below which a hit on ANOTHER surface
+                         than the one a ray leaves is ignored */
+};
+
+/* A hit in the local frame. */
+typedef struct lp__local_hit {
+    double t;
+    lp_vec3 p;
+    lp_vec3 n;      /* outward unit normal */
+    int surface;
+} lp__local_hit;
+
+/* Sag of a cap of curvature c at radius r: c r^2 / (1 + sqrt(1 - c^2 r^2)). */
+double lp__cap_sag(double c, double r);
+
+/* Smallest t in (t_min, t_max) where p + t d meets the cap patch.  When
+ * on_surface is set, p lies on this cap and the root t = 0 is removed
+ * exactly (the remaining root is -2b/c), so a ray never re-hits the point
+ * it leaves.  Returns 1 on a hit. */
+int lp__cap_intersect(const lp__cap *cap, lp_vec3 p, lp_vec3 d, int on_surface,
+                      double t_min, double t_max, double *t);
+/* Outward unit normal at a point of the cap (exactly unit on the surface). */
+lp_vec3 lp__cap_normal(const lp__cap *cap, lp_vec3 p);
+
+int lp__rim_intersect(const lp__rim *rim, lp_vec3 p, lp_vec3 d, double t_min,
+                      double t_max, double *t);
+lp_vec3 lp__rim_normal(const lp__rim *rim, lp_vec3 p);
+
+/* Nearest hit of the local ray p + t d, t in (t_min, t_max), with the
+ * whole surface.  from_surface is the surface p lies on (LP_SURFACE_NONE
+ * for a ray from elsewhere). */
+int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
+                 double t_min, double t_max, lp__local_hit *hit);
+
+/* World <-> local. */
+lp_vec3 lp__to_local_point(const lp_lens *lens, lp_vec3 p);
+lp_vec3 lp__to_local_dir(const lp_lens *lens, lp_vec3 d);
+lp_vec3 lp__to_world_point(const lp_lens *lens, lp_vec3 p);
+lp_vec3 lp__to_world_dir(const lp_lens *lens, lp_vec3 d);
+
+#endif

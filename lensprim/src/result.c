@@ -1,0 +1,41 @@
+/* result.c -- the growable list of outgoing rays and its bookkeeping. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "result.h"
+
+void lp_result_init(lp_result *r)
+{
+    if (r)
+        memset(r, 0, sizeof *r);
+}
+
+void lp_result_clear(lp_result *r)
+{
+    if (!r)
+        return;
+    r->count = 0;
+    r->in = r->out = r->skipped = r->absorbed_glass = r->absorbed_rim = r->truncated = 0.0;
+    r->warnings = 0;
+}
+
+void lp_result_release(lp_result *r)
+{
+    if (!r)
+        return;
+    free(r->rays);
+    memset(r, 0, sizeof *r);
+}
+
+lp_out_ray *lp__result_push(lp_result *r)
+{
+    if (r->count == r->capacity) {
+        size_t cap = r->capacity ? 2 * r->capacity : 16;
+        lp_out_ray *p = realloc(r->rays, cap * sizeof *p);
+        if (!p)
+            return NULL;
+        r->rays = p;
+        r->capacity = cap;
+    }
+    return &r->rays[r->count++];
+}

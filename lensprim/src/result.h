@@ -1,0 +1,10 @@
+/* result.h -- appending to an lp_result (internal). */
+#ifndef LP_RESULT_H
+#define LP_RESULT_H
+
+#include "lensprim.h"
+
+/* A slot for one more ray, or NULL when memory runs out. */
+lp_out_ray *lp__result_push(lp_result *r);
+
+#endif

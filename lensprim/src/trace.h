@@ -1,0 +1,43 @@
+/* trace.h -- what forward and backward tracing share (internal). */
+#ifndef LP_TRACE_H
+#define LP_TRACE_H
+
+#include "cvec3.h"
+#include "lens_internal.h"
+
+/* The lens's optics at one wavelength. */
+typedef struct lp__optics {
+    double lambda_nm;
+    double n_glass, n_medium;
+    double alpha;       /* absorption coefficient of the glass, 1/mm */
+    unsigned warnings;  /* LP_WARN_EXTRAPOLATED */
+} lp__optics;
+
+lp_status lp__optics_at(const lp_lens *lens, double lambda_nm, lp__optics *o, lp_error *err);
+
+/* Validate args (NULL gives the defaults) into *out. */
+lp_status lp__args_resolve(const lp_trace_args *args, lp_trace_args *out, lp_error *err);
+
+/* Does the application want an outgoing ray?  Applies flags and filter. */
+int lp__args_keep(const lp_trace_args *a, const lp_branch_info *info);
+
+/* The payload an outgoing field continues with. */
+typedef struct lp__payload {
+    double lambda_nm;
+    int kphi;
+    double op;
+    double phase;   /* phase the field's complex amplitude is relative to */
+    uint64_t ch;
+} lp__payload;
+
+/* Append the field E leaving the lens (local point p, local unit dir d)
+ * to res as one or two linear rays.  Returns LP_ERROR_NO_MEMORY or LP_OK;
+ * adds their power to res->out. */
+lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
+                   lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
+                   uint64_t path, lp_error *err);
+
+/* Make v a unit vector perpendicular to the unit d; 0 if impossible. */
+int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out);
+
+#endif

@@ -1,0 +1,304 @@
+/* trace_backward.c -- from the eye, in two phases.
+ *
+ * build: the view ray's chain through the lens is traced in the eye's
+ * direction; every node where light could come in from outside gives a
+ * query ray.  The geometry of each node is kept.
+ *
+ * gather: light answering query k arrives along -query.dir at node k and
+ * runs back along the chain to node 1, where it leaves towards the eye.
+ * Refraction is reversible, so the light path is the eye path reversed;
+ * at each node G is applied in the direction of light: at node k the
+ * light refracts in (or, k = 1, reflects off the outside), at nodes
+ * k-1..2 it reflects inside, at node 1 it refracts out. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "error.h"
+#include "interface.h"
+#include "trace.h"
+
+typedef struct bw_node {
+    lp_vec3 p;       /* local point */
+    lp_vec3 n;       /* outward normal */
+    lp_vec3 e_out;   /* eye direction inside the glass leaving this node */
+    double seg;      /* length from this node to the next one */
+    int surface;
+} bw_node;
+
+struct lp_backward {
+    const lp_lens *lens;
+    lp_trace_args args;
+    lp__optics optics;
+    lp_vec3 view_dir;              /* local e_0 */
+    int n_nodes;
+    bw_node node[LP_MAX_DEPTH + 1]; /* node[1..n_nodes] */
+    size_t n_queries;
+    lp_query query[LP_MAX_DEPTH];
+    lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
+    int rim_depth;
+    unsigned warnings;
+};
+
+lp_status lp_backward_create(lp_backward **out, lp_error *err)
+{
+    if (!out)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_create: NULL argument");
+    *out = calloc(1, sizeof **out);
+    if (!*out)
+        return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory creating a backward tracer");
+    lp__ok(err);
+    return LP_OK;
+}
+
+void lp_backward_destroy(lp_backward *bw)
+{
+    free(bw);
+}
+
+size_t lp_backward_query_count(const lp_backward *bw)
+{
+    return bw ? bw->n_queries : 0;
+}
+
+const lp_query *lp_backward_queries(const lp_backward *bw)
+{
+    return bw ? bw->query : NULL;
+}
+
+int lp_backward_rim_depth(const lp_backward *bw)
+{
+    return bw ? bw->rim_depth : 0;
+}
+
+/* Power factors of a node for the bound (max over s/p) and the
+ * unpolarized weight of the mode. */
+static double node_bound(const lp__node *nd, lp_mode mode, int reflect)
+{
+    if (mode != LP_MODE_POLARIZED) {
+        double R = lp__node_reflectance(nd, mode);
+        return reflect ? R : 1.0 - R;
+    }
+    if (reflect)
+        return fmax(nd->f.Rs, nd->f.Rp);
+    return fmax(nd->f.ts * nd->f.ts, nd->f.tp * nd->f.tp);
+}
+
+static double node_weight(const lp__node *nd, lp_mode mode, int reflect)
+{
+    double R = lp__node_reflectance(nd, mode == LP_MODE_POLARIZED ? LP_MODE_FRESNEL : mode);
+    return reflect ? R : 1.0 - R;
+}
+
+static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
+                      uint64_t path, double op, double bound, double weight)
+{
+    const lp_lens *lens = bw->lens;
+    lp_query *q = &bw->query[bw->n_queries];
+    lp_branch_info info;
+
+    q->origin = lp__to_world_point(lens, bw->node[depth].p);
+    q->dir = lp__to_world_dir(lens, dir);
+    q->depth = depth;
+    q->kind = kind;
+    q->surface = surface;
+    q->path = path;
+    q->op = op;
+    q->bound = bound;
+    q->weight = weight;
+    if (bound < bw->args.min_weight)
+        return;
+    info.depth = depth;
+    info.kind = kind;
+    info.surface = surface;
+    info.origin = q->origin;
+    info.dir = q->dir;
+    info.bound = bound;
+    if (!lp__args_keep(&bw->args, &info))
+        return;
+    bw->query_dir[bw->n_queries] = dir;
+    bw->n_queries++;
+}
+
+lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin, lp_vec3 dir,
+                            double lambda_nm, const lp_trace_args *args, lp_error *err)
+{
+    lp__local_hit h;
+    lp__node nd;
+    lp_status st;
+
+    if (!bw || !lens)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_build: NULL argument");
+    bw->lens = lens;
+    bw->n_nodes = 0;
+    bw->n_queries = 0;
+    bw->rim_depth = 0;
+    bw->warnings = 0;
+    if ((st = lp__args_resolve(args, &bw->args, err)) != LP_OK)
+        return st;
+    if (!v3_finite(origin) || !v3_finite(dir))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "view ray is not finite");
+    lp_vec3 dw = v3_normalize(dir);
+    if (dw.x == 0.0 && dw.y == 0.0 && dw.z == 0.0)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "view ray direction is the zero vector");
+    if ((st = lp__optics_at(lens, lambda_nm, &bw->optics, err)) != LP_OK)
+        return st;
+    bw->warnings = bw->optics.warnings;
+
+    const lp__optics *o = &bw->optics;
+    lp_mode mode = bw->args.mode;
+    lp_vec3 p = lp__to_local_point(lens, origin), d = lp__to_local_dir(lens, dw);
+    bw->view_dir = d;
+    if (!lp__lens_hit(lens, p, d, LP_SURFACE_NONE, 0.0, INFINITY, &h)) {
+        lp__ok(err);
+        return LP_OK;
+    }
+    if (h.surface == LP_SURFACE_RIM) {
+        bw->rim_depth = 1;
+        lp__ok(err);
+        return LP_OK;
+    }
+
+    int entry = h.surface;
+    bw->n_nodes = 1;
+    bw->node[1].p = h.p;
+    bw->node[1].n = h.n;
+    bw->node[1].surface = h.surface;
+    int tir = lp__node_setup(&nd, d, h.n, o->n_medium, o->n_glass, NULL);
+    lp__branch br;
+    lp__cvec3 zero = {0, 0, 0};
+    lp__node_reflect(&nd, mode, &zero, &br);
+    add_query(bw, 1, LP_KIND_REFLECT, h.surface, br.dir, 1u, 0.0, node_bound(&nd, mode, 1),
+              node_weight(&nd, mode, 1));
+    if (tir) {
+        lp__ok(err);
+        return LP_OK;
+    }
+
+    lp__node_transmit(&nd, mode, &zero, &br);
+    double bound = node_bound(&nd, mode, 0), weight = node_weight(&nd, mode, 0), op = 0.0;
+    uint64_t path = 0;
+    int depth = 1;
+    d = br.dir;
+    p = h.p;
+    int surface = h.surface;
+    bw->node[1].e_out = d;
+
+    while (depth < bw->args.max_depth && !(bound < bw->args.min_weight)) {
+        if (!lp__lens_hit(lens, p, d, surface, 0.0, INFINITY, &h)) {
+            bw->warnings |= LP_WARN_LEAK;
+            break;
+        }
+        double att = o->alpha > 0.0 ? exp(-o->alpha * h.t) : 1.0;
+        bound *= att;
+        weight *= att;
+        op += o->n_glass * h.t;
+        bw->node[depth].seg = h.t;
+        if (h.surface == LP_SURFACE_RIM) {
+            bw->rim_depth = depth + 1;
+            break;
+        }
+        depth++;
+        bw->n_nodes = depth;
+        bw->node[depth].p = h.p;
+        bw->node[depth].n = h.n;
+        bw->node[depth].surface = h.surface;
+        tir = lp__node_setup(&nd, d, h.n, o->n_glass, o->n_medium, NULL);
+        if (!tir) {
+            lp__node_transmit(&nd, mode, &zero, &br);
+            add_query(bw, depth, h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
+                      h.surface, br.dir, path, op, bound * node_bound(&nd, mode, 0),
+                      weight * node_weight(&nd, mode, 0));
+        }
+        lp__node_reflect(&nd, mode, &zero, &br);
+        bound *= node_bound(&nd, mode, 1);
+        weight *= node_weight(&nd, mode, 1);
+        path |= (uint64_t)1 << (depth - 1);
+        d = br.dir;
+        p = h.p;
+        surface = h.surface;
+        bw->node[depth].e_out = d;
+    }
+    lp__ok(err);
+    return LP_OK;
+}
+
+/* One bundle ray through the path of a query, in the direction of light. */
+static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, lp_result *res,
+                            lp_error *err)
+{
+    const lp__optics *o = &bw->optics;
+    const lp_query *q = &bw->query[qi];
+    lp_mode mode = bw->args.mode;
+    lp__node nd;
+    lp__branch br;
+    lp_vec3 light = v3_neg(bw->query_dir[qi]); /* local, arriving at node k */
+    lp_vec3 vp;
+    int k = q->depth;
+
+    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
+        !isfinite(b->phase))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
+    if (!v3_finite(b->vp) ||
+        !lp__perp_unit(lp__to_local_dir(bw->lens, b->vp), light, &vp))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "bundle ray polarization must be finite and not parallel to the query ray");
+
+    double I0 = b->intensity;
+    lp__cvec3 E = cv3_real(vp, sqrt(I0));
+    lp__payload pl = {o->lambda_nm, b->kphi, b->op + q->op, b->phase, b->ch};
+    double absorbed = 0.0;
+    res->in += I0;
+
+    if (k == 1) {
+        lp__node_setup(&nd, light, bw->node[1].n, o->n_medium, o->n_glass, &E);
+        lp__node_reflect(&nd, mode, &E, &br);
+        E = br.E;
+        pl.kphi += br.flip;
+    } else {
+        lp__node_setup(&nd, light, bw->node[k].n, o->n_medium, o->n_glass, &E);
+        lp__node_transmit(&nd, mode, &E, &br);
+        E = br.E;
+        for (int j = k - 1; j >= 1; j--) {
+            double s = bw->node[j].seg;
+            if (o->alpha > 0.0) {
+                absorbed += cv3_norm2(E) * -expm1(-o->alpha * s);
+                E = cv3_scale(E, exp(-0.5 * o->alpha * s));
+            }
+            lp_vec3 dj = v3_neg(bw->node[j].e_out);
+            lp__node_setup(&nd, dj, bw->node[j].n, o->n_glass, o->n_medium, &E);
+            if (j > 1) {
+                lp__node_reflect(&nd, mode, &E, &br);
+                pl.kphi += br.flip;
+            } else {
+                lp__node_transmit(&nd, mode, &E, &br);
+            }
+            E = br.E;
+        }
+    }
+    double before = res->out;
+    lp_status st = lp__emit(bw->lens, res, &E, bw->node[1].p, v3_neg(bw->view_dir), &pl, k,
+                            q->kind, q->surface, q->path, err);
+    if (st != LP_OK)
+        return st;
+    res->absorbed_glass += absorbed;
+    res->truncated += I0 - (res->out - before) - absorbed;
+    return LP_OK;
+}
+
+lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
+                             lp_result *out, lp_error *err)
+{
+    lp_status st;
+    if (!bw || !out || (!bundle && n > 0))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_gather: NULL argument");
+    if (q >= bw->n_queries)
+        return lp__fail(err, LP_ERROR_RANGE, "query %zu does not exist (%zu queries)", q,
+                        bw->n_queries);
+    out->warnings |= bw->warnings;
+    for (size_t i = 0; i < n; i++)
+        if ((st = gather_one(bw, q, &bundle[i], out, err)) != LP_OK)
+            return st;
+    lp__ok(err);
+    return LP_OK;
+}

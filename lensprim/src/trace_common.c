@@ -1,0 +1,115 @@
+/* trace_common.c -- wavelength set-up, argument checks and emitting
+ * outgoing rays, shared by forward and backward tracing. */
+#include <math.h>
+
+#include "error.h"
+#include "polarization.h"
+#include "result.h"
+#include "trace.h"
+
+lp_status lp__optics_at(const lp_lens *lens, double lambda_nm, lp__optics *o, lp_error *err)
+{
+    const lp_lens_desc *d = &lens->desc;
+    if (!isfinite(lambda_nm) || !(lambda_nm > 0.0))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "wavelength %g nm must be a finite number > 0", lambda_nm);
+    o->lambda_nm = lambda_nm;
+    o->n_glass = lp_glass_index(&d->glass, lambda_nm);
+    o->n_medium = lp_glass_index(&d->medium, lambda_nm);
+    o->alpha = lp_glass_absorption(&d->glass, lambda_nm);
+    if (!isfinite(o->n_glass) || !(o->n_glass > 0.0))
+        return lp__fail(err, LP_ERROR_INVALID_GLASS, "glass %s has no valid index at %g nm",
+                        d->glass.name, lambda_nm);
+    if (!isfinite(o->n_medium) || !(o->n_medium > 0.0))
+        return lp__fail(err, LP_ERROR_INVALID_GLASS,
+                        "medium %s has no valid index at %g nm", d->medium.name, lambda_nm);
+    if (!isfinite(o->alpha) || o->alpha < 0.0)
+        o->alpha = 0.0;
+    o->warnings = 0;
+    if (!lp_glass_covers(&d->glass, lambda_nm) || !lp_glass_covers(&d->medium, lambda_nm))
+        o->warnings |= LP_WARN_EXTRAPOLATED;
+    return LP_OK;
+}
+
+void lp_trace_args_init(lp_trace_args *args)
+{
+    if (!args)
+        return;
+    args->mode = LP_MODE_POLARIZED;
+    args->max_depth = 5;
+    args->min_weight = 0.0;
+    args->flags = 0;
+    args->filter = NULL;
+    args->user = NULL;
+}
+
+lp_status lp__args_resolve(const lp_trace_args *args, lp_trace_args *out, lp_error *err)
+{
+    if (!args) {
+        lp_trace_args_init(out);
+        return LP_OK;
+    }
+    *out = *args;
+    if (args->mode != LP_MODE_POLARIZED && args->mode != LP_MODE_FRESNEL &&
+        args->mode != LP_MODE_SCHLICK)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "unknown mode %d", (int)args->mode);
+    if (args->max_depth < 1 || args->max_depth > LP_MAX_DEPTH)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "depth %d must be in 1..%d",
+                        args->max_depth, LP_MAX_DEPTH);
+    if (!(args->min_weight >= 0.0) || !isfinite(args->min_weight))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "min_weight %g must be a finite number >= 0", args->min_weight);
+    return LP_OK;
+}
+
+int lp__args_keep(const lp_trace_args *a, const lp_branch_info *info)
+{
+    if (info->kind == LP_KIND_REFLECT) {
+        if (a->flags & LP_SKIP_REFLECTED)
+            return 0;
+        if ((a->flags & LP_SKIP_EXTERNAL_REFLECTION) && info->depth == 1)
+            return 0;
+    }
+    return a->filter ? a->filter(info, a->user) != 0 : 1;
+}
+
+int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
+{
+    lp_vec3 w = v3_sub(v, v3_scale(d, v3_dot(v, d)));
+    double l = v3_len(w), lv = v3_len(v);
+    if (!(l > 1e-12 * lv) || !isfinite(l))
+        return 0;
+    *out = v3_scale(w, 1.0 / l);
+    return 1;
+}
+
+lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
+                   lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
+                   uint64_t path, lp_error *err)
+{
+    lp__linear_part part[2];
+    int n = lp__field_split(E, d, part);
+    lp_vec3 wp = lp__to_world_point(lens, p), wd = lp__to_world_dir(lens, d);
+
+    for (int k = 0; k < n; k++) {
+        lp_out_ray *o = lp__result_push(res);
+        if (!o)
+            return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
+        o->ray.origin = wp;
+        o->ray.dir = wd;
+        o->ray.lambda_nm = pl->lambda_nm;
+        o->ray.intensity = part[k].intensity;
+        o->ray.vp = lp__to_world_dir(lens, part[k].vp);
+        o->ray.kphi = pl->kphi;
+        o->ray.op = pl->op;
+        o->ray.phase = remainder(pl->phase + part[k].phase, 2.0 * LP_PI);
+        o->ray.ch = pl->ch;
+        o->depth = depth;
+        o->kind = kind;
+        o->surface = surface;
+        o->part = k;
+        o->path = path;
+        res->out += part[k].intensity;
+    }
+    return LP_OK;
+}

@@ -1,0 +1,191 @@
+/* trace_forward.c -- one ray from the light through the lens.
+ *
+ * The entry node splits the ray into the external reflection and one
+ * refracted ray; every later node on a cap sends one ray out and reflects
+ * one back in (or only reflects it, under TIR), so the rays inside form a
+ * chain and the outgoing rays branch off it, one per depth (paper, fig. 3).
+ * Between nodes the field loses exp(-alpha s) of its power and gains the
+ * optical path n s. */
+#include <math.h>
+
+#include "error.h"
+#include "interface.h"
+#include "trace.h"
+
+/* Send one outgoing field to the result, or count it as skipped. */
+static lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
+                       const lp__branch *b, lp_vec3 p, const lp__payload *pl, int depth,
+                       lp_kind kind, int surface, uint64_t path, lp_error *err)
+{
+    lp_branch_info info;
+    double power = cv3_norm2(b->E);
+
+    info.depth = depth;
+    info.kind = kind;
+    info.surface = surface;
+    info.origin = lp__to_world_point(lens, p);
+    info.dir = lp__to_world_dir(lens, b->dir);
+    info.bound = power;
+    if (!lp__args_keep(a, &info)) {
+        res->skipped += power;
+        return LP_OK;
+    }
+    return lp__emit(lens, res, &b->E, p, b->dir, pl, depth, kind, surface, path, err);
+}
+
+static lp_status check_ray(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err)
+{
+    if (!v3_finite(in->origin))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "ray origin is not finite");
+    if (!v3_finite(in->dir))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "ray direction is not finite");
+    *d = v3_normalize(in->dir);
+    if (d->x == 0.0 && d->y == 0.0 && d->z == 0.0)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "ray direction is the zero vector");
+    if (!isfinite(in->intensity) || in->intensity < 0.0)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "ray intensity %g must be a finite number >= 0", in->intensity);
+    if (!isfinite(in->op) || !isfinite(in->phase))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "ray op/phase is not finite");
+    if (!v3_finite(in->vp) || !lp__perp_unit(in->vp, *d, vp))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "polarization vector must be finite and not parallel to the direction");
+    return LP_OK;
+}
+
+static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace_args *a,
+                           lp_result *res, lp_error *err)
+{
+    lp_vec3 dw, vpw;
+    lp__optics o;
+    lp__local_hit h;
+    lp__node node;
+    lp__branch refl, trans;
+    lp_status st;
+
+    if ((st = check_ray(in, &dw, &vpw, err)) != LP_OK)
+        return st;
+    if ((st = lp__optics_at(lens, in->lambda_nm, &o, err)) != LP_OK)
+        return st;
+
+    lp_vec3 p = lp__to_local_point(lens, in->origin);
+    lp_vec3 d = lp__to_local_dir(lens, dw);
+    if (!lp__lens_hit(lens, p, d, LP_SURFACE_NONE, 0.0, INFINITY, &h))
+        return LP_OK; /* missed: the lens received nothing */
+
+    double I0 = in->intensity;
+    res->in += I0;
+    res->warnings |= o.warnings;
+    if (h.surface == LP_SURFACE_RIM) {
+        res->absorbed_rim += I0;
+        return LP_OK;
+    }
+
+    lp__payload pl = {in->lambda_nm, in->kphi, in->op, in->phase, in->ch};
+    lp__cvec3 E = cv3_real(lp__to_local_dir(lens, vpw), sqrt(I0));
+    int entry = h.surface, depth = 1;
+    uint64_t path = 0;
+
+    /* Node 1: from the medium into the glass. */
+    int tir = lp__node_setup(&node, d, h.n, o.n_medium, o.n_glass, &E);
+    lp__node_reflect(&node, a->mode, &E, &refl);
+    {
+        lp__payload pr = pl;
+        pr.kphi += refl.flip;
+        st = leave(lens, a, res, &refl, h.p, &pr, 1, LP_KIND_REFLECT, h.surface, path | 1u, err);
+        if (st != LP_OK)
+            return st;
+    }
+    if (tir)
+        return LP_OK;
+    lp__node_transmit(&node, a->mode, &E, &trans);
+    E = trans.E;
+    d = trans.dir;
+    p = h.p;
+    int surface = h.surface;
+
+    for (;;) {
+        double power = cv3_norm2(E);
+        if (depth >= a->max_depth || power < a->min_weight * I0) {
+            res->truncated += power;
+            break;
+        }
+        if (!lp__lens_hit(lens, p, d, surface, 0.0, INFINITY, &h)) {
+            res->absorbed_rim += power; /* cannot happen on a closed surface */
+            res->warnings |= LP_WARN_LEAK;
+            break;
+        }
+        /* Along the segment: Beer-Lambert and the optical path. */
+        if (o.alpha > 0.0) {
+            res->absorbed_glass += power * -expm1(-o.alpha * h.t);
+            E = cv3_scale(E, exp(-0.5 * o.alpha * h.t));
+        }
+        pl.op += o.n_glass * h.t;
+        p = h.p;
+        surface = h.surface;
+        if (surface == LP_SURFACE_RIM) {
+            res->absorbed_rim += cv3_norm2(E);
+            break;
+        }
+
+        depth++;
+        tir = lp__node_setup(&node, d, h.n, o.n_glass, o.n_medium, &E);
+        if (!tir) {
+            lp__node_transmit(&node, a->mode, &E, &trans);
+            lp_kind kind = surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
+            st = leave(lens, a, res, &trans, p, &pl, depth, kind, surface, path, err);
+            if (st != LP_OK)
+                return st;
+        }
+        lp__node_reflect(&node, a->mode, &E, &refl);
+        E = refl.E;
+        d = refl.dir;
+        pl.kphi += refl.flip;
+        path |= (uint64_t)1 << (depth - 1);
+    }
+    return LP_OK;
+}
+
+lp_status lp_trace_forward(const lp_lens *lens, const lp_ray *in, const lp_trace_args *args,
+                           lp_result *out, lp_error *err)
+{
+    lp_trace_args a;
+    lp_status st;
+
+    if (!lens || !in || !out)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_trace_forward: NULL argument");
+    lp_result_clear(out);
+    if ((st = lp__args_resolve(args, &a, err)) != LP_OK)
+        return st;
+    if ((st = trace_one(lens, in, &a, out, err)) != LP_OK)
+        return st;
+    lp__ok(err);
+    return LP_OK;
+}
+
+lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in, size_t n,
+                                const lp_trace_args *args, lp_result *out, size_t *offsets,
+                                lp_error *err)
+{
+    lp_trace_args a;
+    lp_status st;
+
+    if (!lens || (!in && n > 0) || !out || !offsets)
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_trace_forward_many: NULL argument");
+    lp_result_clear(out);
+    if ((st = lp__args_resolve(args, &a, err)) != LP_OK)
+        return st;
+    for (size_t i = 0; i < n; i++) {
+        offsets[i] = out->count;
+        if ((st = trace_one(lens, &in[i], &a, out, err)) != LP_OK) {
+            if (err) {
+                lp_error e = *err;
+                lp__fail(err, st, "ray %zu: %s", i, e.message);
+            }
+            return st;
+        }
+    }
+    offsets[n] = out->count;
+    lp__ok(err);
+    return LP_OK;
+}
