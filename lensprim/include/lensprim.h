@@ -331,6 +331,7 @@ typedef struct lp_result {
     size_t capacity;
     double in, out, skipped, absorbed_glass, absorbed_rim, truncated;
     unsigned warnings;
+    size_t nodes;     /* interface interactions computed (a cost measure) */
 } lp_result;
 
 LP_API void lp_result_init(lp_result *result);

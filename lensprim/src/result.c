@@ -17,6 +17,7 @@ void lp_result_clear(lp_result *r)
     r->count = 0;
     r->in = r->out = r->skipped = r->absorbed_glass = r->absorbed_rim = r->truncated = 0.0;
     r->warnings = 0;
+    r->nodes = 0;
 }
 
 void lp_result_release(lp_result *r)

@@ -276,6 +276,7 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, l
             E = br.E;
         }
     }
+    res->nodes += (size_t)k;
     double before = res->out;
     lp_status st = lp__emit(bw->lens, res, &E, bw->node[1].p, v3_neg(bw->view_dir), &pl, k,
                             q->kind, q->surface, q->path, err);

@@ -88,6 +88,7 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
 
     /* Node 1: from the medium into the glass. */
     int tir = lp__node_setup(&node, d, h.n, o.n_medium, o.n_glass, &E);
+    res->nodes++;
     lp__node_reflect(&node, a->mode, &E, &refl);
     {
         lp__payload pr = pl;
@@ -130,6 +131,7 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
 
         depth++;
         tir = lp__node_setup(&node, d, h.n, o.n_glass, o.n_medium, &E);
+        res->nodes++;
         if (!tir) {
             lp__node_transmit(&node, a->mode, &E, &trans);
             lp_kind kind = surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;

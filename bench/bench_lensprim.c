@@ -1,0 +1,135 @@
+/* bench_lensprim.c -- lens-tree nodes per second per core.
+ *
+ * A benchmark, not a test: it traces random rays through the default lens
+ * (biconvex N-BK7, R 50/-50, t 8, D 25) in each mode and depth, forward
+ * (one call per ray and the batch entry point) and backward (build +
+ * gather of a one-ray bundle per query), on one thread, and prints
+ * nodes/s and the time ratio of each mode to polarized measured in the
+ * same run.  Usage: bench_lensprim [rays] (default 200000). */
+#define _POSIX_C_SOURCE 199309L
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "lensprim.h"
+
+#define PI 3.14159265358979323846
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
+static double uniform(void)
+{
+    uint64_t z = (rng_state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (z >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static void random_ray(lp_ray *r)
+{
+    double rho = 12.0 * sqrt(uniform()), phi = 2.0 * PI * uniform();
+    double tilt = 0.3 * uniform(), az = 2.0 * PI * uniform();
+    r->origin = (lp_vec3){rho * cos(phi), rho * sin(phi), -20.0};
+    r->dir = (lp_vec3){sin(tilt) * cos(az), sin(tilt) * sin(az), cos(tilt)};
+    r->lambda_nm = 380.0 + 400.0 * uniform();
+    r->intensity = 1.0;
+    r->vp = (lp_vec3){cos(az + 1.0), sin(az + 1.0), 0.0};
+    r->kphi = 0;
+    r->op = 0.0;
+    r->phase = 0.0;
+    r->ch = 1;
+}
+
+int main(int argc, char **argv)
+{
+    size_t n = argc > 1 ? strtoul(argv[1], NULL, 10) : 200000;
+    lp_lens_desc desc;
+    lp_lens *lens;
+    lp_error err;
+    const char *mode_name[] = {"polarized", "fresnel", "schlick"};
+    const int depths[] = {2, 5, 20};
+
+    lp_lens_desc_init(&desc);
+    desc.radius1 = 50;
+    desc.radius2 = -50;
+    desc.thickness = 8;
+    desc.diameter = 25;
+    if (lp_glass_builtin("N-BK7", &desc.glass, &err) != LP_OK ||
+        lp_lens_create(&desc, &lens, &err) != LP_OK) {
+        fprintf(stderr, "bench: %s\n", err.message);
+        return 1;
+    }
+    lp_ray *rays = malloc(n * sizeof *rays);
+    size_t *offsets = malloc((n + 1) * sizeof *offsets);
+    if (!rays || !offsets)
+        return 1;
+    for (size_t i = 0; i < n; i++)
+        random_ray(&rays[i]);
+
+    lp_result res;
+    lp_result_init(&res);
+    lp_backward *bw;
+    lp_backward_create(&bw, &err);
+
+    printf("%zu rays, one thread\n", n);
+    printf("%-10s %5s %14s %14s %14s %10s\n", "mode", "depth", "fwd nodes/s", "batch nodes/s",
+           "bwd nodes/s", "fwd t/pol");
+    for (size_t di = 0; di < sizeof depths / sizeof depths[0]; di++) {
+        double t_pol = 0.0;
+        for (int m = 0; m < 3; m++) {
+            lp_trace_args a;
+            lp_trace_args_init(&a);
+            a.mode = (lp_mode)m;
+            a.max_depth = depths[di];
+
+            size_t nodes = 0;
+            double t0 = now();
+            for (size_t i = 0; i < n; i++) {
+                lp_trace_forward(lens, &rays[i], &a, &res, NULL);
+                nodes += res.nodes;
+            }
+            double t_fwd = now() - t0;
+
+            t0 = now();
+            lp_trace_forward_many(lens, rays, n, &a, &res, offsets, NULL);
+            double t_batch = now() - t0;
+            size_t batch_nodes = res.nodes;
+
+            size_t bnodes = 0;
+            t0 = now();
+            for (size_t i = 0; i < n; i++) {
+                lp_backward_build(bw, lens, rays[i].origin, rays[i].dir, rays[i].lambda_nm, &a,
+                                  NULL);
+                size_t nq = lp_backward_query_count(bw);
+                const lp_query *q = lp_backward_queries(bw);
+                lp_result_clear(&res);
+                for (size_t k = 0; k < nq; k++) {
+                    lp_ray b = rays[i];
+                    b.vp = fabs(q[k].dir.z) < 0.9 ? (lp_vec3){0, 0, 1} : (lp_vec3){1, 0, 0};
+                    lp_backward_gather(bw, k, &b, 1, &res, NULL);
+                }
+                bnodes += res.nodes;
+            }
+            double t_bwd = now() - t0;
+            if (m == 0)
+                t_pol = t_fwd;
+            printf("%-10s %5d %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], depths[di],
+                   nodes / t_fwd, batch_nodes / t_batch, bnodes / t_bwd, t_fwd / t_pol);
+        }
+    }
+    lp_backward_destroy(bw);
+    lp_result_release(&res);
+    free(rays);
+    free(offsets);
+    lp_lens_destroy(lens);
+    return 0;
+}
