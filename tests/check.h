@@ -44,7 +44,7 @@ static void check__report(const char *file, int line, const char *fmt, ...)
         }                                                                     \
     } while (0)
 
-static int check__rel(double got, double want, double tol, const char *what)
+static inline int check__rel(double got, double want, double tol, const char *what)
 {
     double e = fabs(got - want) / (want != 0.0 ? fabs(want) : 1.0);
     check__count++;
@@ -59,7 +59,7 @@ static int check__rel(double got, double want, double tol, const char *what)
     return 1;
 }
 
-static int check__abs(double got, double want, double tol, const char *what)
+static inline int check__abs(double got, double want, double tol, const char *what)
 {
     double e = fabs(got - want);
     check__count++;
