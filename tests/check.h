@@ -21,9 +21,9 @@
 static int check__failures;
 static long check__count;
 static double check__worst_rel;
-static char check__worst_rel_what[200];
+static char check__worst_rel_what[512];
 static double check__worst_abs;
-static char check__worst_abs_what[200];
+static char check__worst_abs_what[512];
 
 static void check__report(const char *file, int line, const char *fmt, ...)
 {
@@ -76,7 +76,7 @@ static inline int check__abs(double got, double want, double tol, const char *wh
 
 #define CHECK_REL(got, want, tol, ...)                                        \
     do {                                                                      \
-        char check__w[200];                                                   \
+        char check__w[512];                                                   \
         double check__g = (got), check__x = (want);                           \
         snprintf(check__w, sizeof check__w, __VA_ARGS__);                     \
         if (!check__rel(check__g, check__x, (tol), check__w))                 \
@@ -86,7 +86,7 @@ static inline int check__abs(double got, double want, double tol, const char *wh
 
 #define CHECK_ABS(got, want, tol, ...)                                        \
     do {                                                                      \
-        char check__w[200];                                                   \
+        char check__w[512];                                                   \
         double check__g = (got), check__x = (want);                           \
         snprintf(check__w, sizeof check__w, __VA_ARGS__);                     \
         if (!check__abs(check__g, check__x, (tol), check__w))                 \
