@@ -238,6 +238,28 @@ int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
     return 1;
 }
 
+int lp__lens_surface_at(const lp_lens *lens, lp_vec3 p)
+{
+    double tol = 8.0 * lens->eps;
+    double r2 = p.x * p.x + p.y * p.y;
+    for (int s = LP_SURFACE_FRONT; s <= LP_SURFACE_BACK; s++) {
+        const lp__cap *cap = &lens->cap[s];
+        double z = p.z - cap->z0;
+        /* |grad F| = 2 on the surface, so |F|/2 is the distance to first order */
+        double f = cap->c * (r2 + z * z) - 2.0 * z;
+        if (fabs(f) <= 2.0 * tol && r2 <= cap->h * cap->h * (1.0 + 1e-12) + tol &&
+            cap->c * z <= 1.0)
+            return s;
+    }
+    if (lens->rim.present) {
+        const lp__rim *rim = &lens->rim;
+        double rho = rim->rho_a + rim->k * (p.z - rim->z_a);
+        if (fabs(sqrt(r2) - rho) <= tol && p.z >= rim->z_a - tol && p.z <= rim->z_b + tol)
+            return LP_SURFACE_RIM;
+    }
+    return LP_SURFACE_NONE;
+}
+
 int lp_lens_intersect(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir, double t_min,
                       double t_max, lp_hit *hit)
 {
@@ -247,8 +269,9 @@ int lp_lens_intersect(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir, double t
     lp_vec3 d = v3_normalize(dir);
     if (d.x == 0.0 && d.y == 0.0 && d.z == 0.0)
         return 0;
-    if (!lp__lens_hit(lens, lp__to_local_point(lens, origin), lp__to_local_dir(lens, d),
-                      LP_SURFACE_NONE, t_min, t_max, &h))
+    lp_vec3 p = lp__to_local_point(lens, origin);
+    if (!lp__lens_hit(lens, p, lp__to_local_dir(lens, d), lp__lens_surface_at(lens, p), t_min,
+                      t_max, &h))
         return 0;
     hit->t = h.t;
     hit->point = v3_madd(origin, d, h.t);

@@ -67,6 +67,12 @@ lp_vec3 lp__rim_normal(const lp__rim *rim, lp_vec3 p);
 int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
                  double t_min, double t_max, lp__local_hit *hit);
 
+/* The surface the local point p lies on, to within the lens's rounding
+ * tolerance (a few 1e-12 of its size), or LP_SURFACE_NONE.  Entry points
+ * use it so that a ray starting on the lens (say, one it just emitted)
+ * never meets its own origin again. */
+int lp__lens_surface_at(const lp_lens *lens, lp_vec3 p);
+
 /* World <-> local. */
 lp_vec3 lp__to_local_point(const lp_lens *lens, lp_vec3 p);
 lp_vec3 lp__to_local_dir(const lp_lens *lens, lp_vec3 d);

@@ -148,7 +148,7 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     lp_mode mode = bw->args.mode;
     lp_vec3 p = lp__to_local_point(lens, origin), d = lp__to_local_dir(lens, dw);
     bw->view_dir = d;
-    if (!lp__lens_hit(lens, p, d, LP_SURFACE_NONE, 0.0, INFINITY, &h)) {
+    if (!lp__lens_hit(lens, p, d, lp__lens_surface_at(lens, p), 0.0, INFINITY, &h)) {
         lp__ok(err);
         return LP_OK;
     }

@@ -70,7 +70,7 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
 
     lp_vec3 p = lp__to_local_point(lens, in->origin);
     lp_vec3 d = lp__to_local_dir(lens, dw);
-    if (!lp__lens_hit(lens, p, d, LP_SURFACE_NONE, 0.0, INFINITY, &h))
+    if (!lp__lens_hit(lens, p, d, lp__lens_surface_at(lens, p), 0.0, INFINITY, &h))
         return LP_OK; /* missed: the lens received nothing */
 
     double I0 = in->intensity;

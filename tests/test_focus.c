@@ -1,0 +1,289 @@
+/* test_focus.c -- thick-lens focal lengths and spherical aberration.
+ *
+ * Paraxial rays through a lens of constant index n in air cross the axis
+ * at the thick-lens back focal length from the back vertex:
+ *     1/f = (n-1) [c1 - c2 + (n-1) t c1 c2 / n],   c = 1/R (0 for flat)
+ *     BFL = f (1 - (n-1) t c1 / n)
+ * (Hecht, "Optics", 6.2; lensmaker's equation for a thick lens).  Rays
+ * entering from behind see the mirrored lens R1' = -R2, R2' = -R1 and
+ * focus at BFL' in front of the front vertex.  Real (marginal) rays are
+ * compared with an exact meridional trace written here (Snell's law at
+ * two spheres, long double), and the third-order trend of spherical
+ * aberration, LA ~ h^2, is checked by the ratio LA(h)/LA(h/2) ~ 4.
+ * Nothing expected is taken from the library.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "check.h"
+#include "lensprim.h"
+
+static const double N_GLASS = 1.5168;
+
+static lp_vec3 V(double x, double y, double z) { lp_vec3 v = {x, y, z}; return v; }
+static double vdot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static lp_vec3 vsub(lp_vec3 a, lp_vec3 b) { return V(a.x - b.x, a.y - b.y, a.z - b.z); }
+static lp_vec3 vadd(lp_vec3 a, lp_vec3 b) { return V(a.x + b.x, a.y + b.y, a.z + b.z); }
+static lp_vec3 vscale(lp_vec3 a, double s) { return V(a.x * s, a.y * s, a.z * s); }
+static lp_vec3 vcross(lp_vec3 a, lp_vec3 b)
+{
+    return V(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static lp_vec3 vnorm(lp_vec3 a) { return vscale(a, 1.0 / sqrt(vdot(a, a))); }
+
+static double curv(double R) { return (R == 0.0 || isinf(R)) ? 0.0 : 1.0 / R; }
+
+/* thick-lens back focal length, light entering the R1 side */
+static double bfl_formula(double R1, double R2, double t, double n)
+{
+    double c1 = curv(R1), c2 = curv(R2);
+    double P = (n - 1) * (c1 - c2 + (n - 1) * t * c1 * c2 / n);
+    double f = 1.0 / P;
+    return f * (1 - (n - 1) * t * c1 / n);
+}
+
+/* ---- exact meridional trace (x, z), long double ------------------- */
+
+/* nearest s > 0 with c(x^2 + Z^2) - 2Z = 0, Z = z - z0, on the vertex branch */
+static long double surf_hit(long double c, long double z0, long double x, long double z,
+                            long double dx, long double dz)
+{
+    long double Z = z - z0;
+    long double A = c, B = c * (x * dx + Z * dz) - dz, C = c * (x * x + Z * Z) - 2 * Z;
+    long double r[2];
+    int nr = 0;
+    if (A == 0) {
+        r[nr++] = -C / (2 * B);
+    } else {
+        long double disc = B * B - A * C;
+        if (disc < 0)
+            return -1;
+        long double q = -(B + copysignl(sqrtl(disc), B));
+        r[nr++] = q / A;
+        r[nr++] = C / q;
+    }
+    long double best = -1;
+    for (int i = 0; i < nr; i++) {
+        long double zz = z + r[i] * dz - z0;
+        if (r[i] > 1e-12L && c * zz < 1 && (best < 0 || r[i] < best))
+            best = r[i];
+    }
+    return best;
+}
+
+static void surf_refract(long double c, long double z0, long double x, long double z, long double *dx,
+                         long double *dz, long double n1, long double n2)
+{
+    long double nx = c * x, nz = c * (z - z0) - 1;
+    long double L = sqrtl(nx * nx + nz * nz);
+    nx /= L;
+    nz /= L;
+    long double ci = -(*dx * nx + *dz * nz);
+    if (ci < 0) {
+        nx = -nx;
+        nz = -nz;
+        ci = -ci;
+    }
+    long double eta = n1 / n2;
+    long double ct = sqrtl(1 - eta * eta * (1 - ci * ci));
+    long double ex = eta * *dx + (eta * ci - ct) * nx;
+    long double ez = eta * *dz + (eta * ci - ct) * nz;
+    long double l = sqrtl(ex * ex + ez * ez);
+    *dx = ex / l;
+    *dz = ez / l;
+}
+
+/* Axis crossing z of a ray parallel to the axis at height h, entering
+ * from the front (back = 0, travelling +z) or from behind (travelling -z). */
+static long double exact_crossing(double R1, double R2, double t, double n, double h, int back)
+{
+    long double c[2] = {curv(R1), curv(R2)}, z0[2] = {0, t};
+    long double x = h, z = back ? t + 10.0L : -10.0L, dx = 0, dz = back ? -1 : 1;
+    for (int k = 0; k < 2; k++) {
+        int s = back ? 1 - k : k;
+        long double d = surf_hit(c[s], z0[s], x, z, dx, dz);
+        x += d * dx;
+        z += d * dz;
+        if (k == 0)
+            surf_refract(c[s], z0[s], x, z, &dx, &dz, 1.0L, n);
+        else
+            surf_refract(c[s], z0[s], x, z, &dx, &dz, n, 1.0L);
+    }
+    return z - x * dz / dx;
+}
+
+/* ---- library side ------------------------------------------------- */
+
+typedef struct { lp_vec3 P, e1, e2, A; } frame;
+
+static frame frame_make(lp_vec3 P, lp_vec3 A)
+{
+    frame f;
+    f.P = P;
+    f.A = vnorm(A);
+    lp_vec3 h = fabs(f.A.x) < 0.6 ? V(1, 0, 0) : (fabs(f.A.y) < 0.6 ? V(0, 1, 0) : V(0, 0, 1));
+    f.e1 = vnorm(vcross(f.A, h));
+    f.e2 = vcross(f.A, f.e1);
+    return f;
+}
+
+static lp_lens *make_lens(double R1, double R2, double t, double D, const frame *f)
+{
+    lp_lens_desc desc;
+    lp_lens_desc_init(&desc);
+    desc.radius1 = R1;
+    desc.radius2 = R2;
+    desc.thickness = t;
+    desc.diameter = D;
+    lp_glass_init_constant(&desc.glass, N_GLASS);
+    desc.position = f->P;
+    desc.axis = f->A;
+    lp_lens *lens = NULL;
+    lp_error err;
+    if (lp_lens_create(&desc, &lens, &err) != LP_OK) {
+        CHECK(0, "lens R1=%g R2=%g t=%g D=%g refused: %s", R1, R2, t, D, err.message);
+        return NULL;
+    }
+    return lens;
+}
+
+/* Trace a ray parallel to the axis at height h (local x), entering from
+ * the front or from behind; return the local axis crossing z of the
+ * depth-2 transmitted ray (NAN when there is none). */
+static double lib_crossing(const lp_lens *lens, const frame *f, double t, double h, int back,
+                           const char *what)
+{
+    lp_ray in;
+    memset(&in, 0, sizeof in);
+    double z0 = back ? t + 10.0 : -10.0;
+    in.origin = vadd(f->P, vadd(vscale(f->e1, h), vscale(f->A, z0)));
+    in.dir = back ? vscale(f->A, -1) : f->A;
+    in.lambda_nm = 587.56;
+    in.intensity = 1;
+    in.vp = f->e2;
+    lp_trace_args args;
+    lp_trace_args_init(&args);
+    args.max_depth = 3;
+    lp_result res;
+    lp_result_init(&res);
+    lp_status st = lp_trace_forward(lens, &in, &args, &res, NULL);
+    CHECK(st == LP_OK, "%s: trace status %d", what, (int)st);
+    double zc = NAN;
+    int found = 0;
+    for (size_t i = 0; i < res.count; i++) {
+        const lp_out_ray *o = &res.rays[i];
+        if (o->depth != 2 || o->kind != LP_KIND_TRANSMIT)
+            continue;
+        found++;
+        CHECK(o->surface == (back ? LP_SURFACE_FRONT : LP_SURFACE_BACK),
+              "%s: transmitted ray leaves through surface %d", what, o->surface);
+        lp_vec3 r = vsub(o->ray.origin, f->P);
+        double x = vdot(r, f->e1), y = vdot(r, f->e2), z = vdot(r, f->A);
+        double dx = vdot(o->ray.dir, f->e1), dy = vdot(o->ray.dir, f->e2), dz = vdot(o->ray.dir, f->A);
+        CHECK_ABS(y, 0.0, 1e-12 * (1 + sqrt(vdot(f->P, f->P))), "%s: meridional ray stays in its plane (origin)",
+                  what);
+        CHECK_ABS(dy, 0.0, 1e-12, "%s: meridional ray stays in its plane (dir)", what);
+        zc = z - x * dz / dx;
+    }
+    CHECK(found == 1, "%s: %d depth-2 transmitted rays, want 1", what, found);
+    lp_result_release(&res);
+    return zc;
+}
+
+static double worst_exact, worst_parax;
+
+typedef struct {
+    const char *name;
+    double R1, R2, t, D;
+} lens_case;
+
+static void run_case(const lens_case *c, const frame *f, int back)
+{
+    char what[160];
+    lp_lens *lens = make_lens(c->R1, c->R2, c->t, c->D, f);
+    if (!lens)
+        return;
+    /* the lens as the light sees it */
+    double R1 = back ? -c->R2 : c->R1, R2 = back ? -c->R1 : c->R2;
+    double bfl = bfl_formula(R1, R2, c->t, N_GLASS);
+    /* BFL measured from the last vertex along the light's direction */
+    double zlast = back ? 0.0 : c->t, sgn = back ? -1.0 : 1.0;
+    double a = c->D / 2;
+
+    snprintf(what, sizeof what, "%s%s paraxial h=1e-4a", c->name, back ? " (from behind)" : "");
+    double z1 = lib_crossing(lens, f, c->t, 1e-4 * a, back, what);
+    double b1 = sgn * (z1 - zlast);
+    CHECK_REL(b1, bfl, 1e-4, "%s: BFL vs thick-lens formula", what);
+    worst_parax = fmax(worst_parax, fabs(b1 / bfl - 1));
+
+    snprintf(what, sizeof what, "%s%s paraxial h=2e-4a", c->name, back ? " (from behind)" : "");
+    double z2 = lib_crossing(lens, f, c->t, 2e-4 * a, back, what);
+    double b2 = sgn * (z2 - zlast);
+    CHECK_REL(b2, bfl, 1e-4, "%s: BFL vs thick-lens formula", what);
+    /* LA(2h) - LA(h) ~ 3 k h^2 ~ 3e-9 relative here */
+    CHECK_REL(b2, b1, 1e-7, "%s%s: paraxial heights agree", c->name, back ? " (from behind)" : "");
+
+    /* exact real-ray crossings at several heights */
+    const double fr[] = {1e-4, 0.1, 0.3, 0.45, 0.5, 0.7, 0.9};
+    double la[7];
+    for (int i = 0; i < 7; i++) {
+        snprintf(what, sizeof what, "%s%s h=%ga", c->name, back ? " (from behind)" : "", fr[i]);
+        double z = lib_crossing(lens, f, c->t, fr[i] * a, back, what);
+        double ze = (double)exact_crossing(c->R1, c->R2, c->t, N_GLASS, fr[i] * a, back);
+        CHECK_REL(z - zlast, ze - zlast, 1e-10, "%s: crossing vs exact meridional trace", what);
+        worst_exact = fmax(worst_exact, fabs((z - ze) / (ze - zlast)));
+        la[i] = bfl - sgn * (z - zlast); /* longitudinal aberration */
+    }
+    /* marginal rays cross before the paraxial focus (positive lens:
+     * closer to the lens; negative lens: the virtual focus is closer too) */
+    if (bfl > 0)
+        CHECK(la[6] > 0, "%s%s: marginal LA %g > 0 (undercorrected)", c->name,
+              back ? " (from behind)" : "", la[6]);
+    else
+        CHECK(la[6] < 0, "%s%s: negative lens marginal virtual focus closer, LA %g < 0", c->name,
+              back ? " (from behind)" : "", la[6]);
+    /* third order: LA(0.9a)/LA(0.45a) ~ 4 */
+    CHECK_ABS(la[6] / la[3], 4.0, 0.4, "%s%s: LA(h)/LA(h/2) (third-order h^2 trend)", c->name,
+              back ? " (from behind)" : "");
+    lp_lens_destroy(lens);
+}
+
+int main(void)
+{
+    const lens_case cases[] = {
+        {"biconvex 50/-50", 50, -50, 8, 25},
+        {"plano-convex 25.8/inf", 25.8, INFINITY, 5.3, 25.4},
+        {"plano-convex inf/-25.8", INFINITY, -25.8, 5.3, 25.4},
+        {"biconcave -50/50", -50, 50, 3, 25},
+        {"plano-concave -40/inf", -40, INFINITY, 2, 25},
+        {"positive meniscus 30/60", 30, 60, 5, 25},
+    };
+    frame id = frame_make(V(0, 0, 0), V(0, 0, 1));
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++)
+        for (int back = 0; back < 2; back++)
+            run_case(&cases[i], &id, back);
+
+    /* the same through placed lenses */
+    const lp_vec3 axes[] = {{0.3, -0.8, 0.5}, {-1, 0, 0}, {0, 0, -1}, {0.1, 0.2, -0.97}};
+    const lp_vec3 pos[] = {{10, -20, 35}, {-3, 4, 5}, {0, 0, 100}, {-60, 12, -7}};
+    for (int k = 0; k < 4; k++) {
+        frame f = frame_make(pos[k], axes[k]);
+        run_case(&cases[k % 3], &f, k & 1);
+    }
+    /* spot values of the formula itself (hand-computed):
+     * biconvex 50/-50, t 8, n 1.5168: 1/f = 0.5168 (0.04 + 0.5168*8*(-0.0004)/1.5168) */
+    {
+        double P = 0.5168 * (0.04 - 0.5168 * 8 * 0.0004 / 1.5168);
+        CHECK_REL(bfl_formula(50, -50, 8, 1.5168), (1 / P) * (1 - 0.5168 * 8 * 0.02 / 1.5168), 1e-15,
+                  "formula sanity");
+        CHECK_REL(bfl_formula(INFINITY, -25.8, 5.3, 1.5168), 25.8 / 0.5168, 1e-15,
+                  "formula: flat side first, BFL = f = R/(n-1)");
+        CHECK_REL(bfl_formula(25.8, INFINITY, 5.3, 1.5168), 25.8 / 0.5168 - 5.3 / 1.5168, 1e-14,
+                  "formula: curved side first, BFL = f - t/n");
+    }
+    printf("test_focus: worst paraxial BFL vs thick-lens formula %.3g (relative), worst real-ray "
+           "crossing vs exact trace %.3g (relative)\n", worst_parax, worst_exact);
+    return check_finish("test_focus");
+}

@@ -1,0 +1,1062 @@
+/* test_reciprocity.c -- forward/backward reciprocity on random paths.
+ *
+ * For a random lens and a view ray V (origin outside, direction d),
+ * lp_backward_build gives the query rays.  For each query (origin Q,
+ * direction u), light arriving along -u into Q with a random linear
+ * payload is
+ *   (a) gathered with lp_backward_gather, and
+ *   (b) traced forward with lp_trace_forward from a point just outside
+ *       the lens on the query ray (Q + s u, direction -u);
+ * the forward ray of the same depth (path bits reversed) must leave at
+ * V's entry point along -d, and both must carry the same intensity
+ * (1e-10 relative) and the same complex field sum over TIR parts of
+ * sqrt(I) vp exp(i Phi), Phi = 2 pi op/lambda - pi kphi + phase (1e-8).
+ * Both are also compared with the exact field computed here: the view
+ * chain traced in long double, and the light carried back along it by
+ * Fresnel's amplitude equations (Born & Wolf, p = k x s basis, complex
+ * TIR coefficients for exp(-i w t)), with n*s propagation phase and
+ * Beer-Lambert absorption of a hand-made glass (tau flat in lambda).
+ * fresnel and schlick modes compare intensities, also with the node
+ * product of (Rs+Rp)/2 or Schlick's law written here.
+ *
+ * Paths that are ill-conditioned in double precision are not compared
+ * (and counted): a node within 1e-6 x size of a cap's edge circle, an
+ * incidence or refraction cosine below 0.02, a refraction sine within
+ * 1e-3 of 1 (near the critical angle), or an angular amplification of
+ * the reverse path above 1e4 (rounding of 1e-16 then grows past 1e-12).
+ * Fixed-seed splitmix64; messages name the seed, lens, view ray, depth.
+ */
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#include "lensprim.h"
+
+/* ------------------------------------------------------------------ */
+/* small helpers                                                       */
+/* ------------------------------------------------------------------ */
+
+static uint64_t rng_state = 0x1234abcd5678ef01ULL;
+static inline uint64_t sm64(void)
+{
+    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+static inline double urand(void) { return (double)(sm64() >> 11) * 0x1.0p-53; }
+static inline double urange(double a, double b) { return a + (b - a) * urand(); }
+
+static lp_vec3 V(double x, double y, double z) { lp_vec3 v = {x, y, z}; return v; }
+static inline lp_vec3 vadd(lp_vec3 a, lp_vec3 b) { return V(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline lp_vec3 vsub(lp_vec3 a, lp_vec3 b) { return V(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline lp_vec3 vscale(lp_vec3 a, double s) { return V(a.x * s, a.y * s, a.z * s); }
+static inline double vdot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline lp_vec3 vcross(lp_vec3 a, lp_vec3 b)
+{
+    return V(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline double vlen(lp_vec3 a) { return sqrt(vdot(a, a)); }
+static inline lp_vec3 vnorm(lp_vec3 a) { return vscale(a, 1.0 / vlen(a)); }
+static inline int vfinite(lp_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+static inline lp_vec3 rand_unit(void)
+{
+    for (;;) {
+        lp_vec3 v = V(urange(-1, 1), urange(-1, 1), urange(-1, 1));
+        double l = vlen(v);
+        if (l > 0.1 && l <= 1.0)
+            return vscale(v, 1.0 / l);
+    }
+}
+
+typedef struct { long double x, y, z; } lv3;
+static lv3 L3(long double x, long double y, long double z) { lv3 v = {x, y, z}; return v; }
+static inline lv3 ladd(lv3 a, lv3 b) { return L3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline lv3 lsub(lv3 a, lv3 b) { return L3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline lv3 lscale(lv3 a, long double s) { return L3(a.x * s, a.y * s, a.z * s); }
+static inline long double ldot(lv3 a, lv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline long double llen(lv3 a) { return sqrtl(ldot(a, a)); }
+static inline lv3 lnorm(lv3 a) { return lscale(a, 1.0L / llen(a)); }
+static inline lv3 lfrom(lp_vec3 a) { return L3(a.x, a.y, a.z); }
+static inline lp_vec3 lto(lv3 a) { return V((double)a.x, (double)a.y, (double)a.z); }
+
+/* A placement: world = P + e1*x + e2*y + A*z (A = the lens axis). */
+typedef struct { lp_vec3 P, e1, e2, A; } frame;
+
+static inline frame frame_make(lp_vec3 P, lp_vec3 A)
+{
+    frame f;
+    f.P = P;
+    f.A = vnorm(A);
+    lp_vec3 h = fabs(f.A.x) < 0.6 ? V(1, 0, 0) : (fabs(f.A.y) < 0.6 ? V(0, 1, 0) : V(0, 0, 1));
+    f.e1 = vnorm(vcross(f.A, h));
+    f.e2 = vcross(f.A, f.e1);
+    return f;
+}
+static inline frame frame_identity(void) { return frame_make(V(0, 0, 0), V(0, 0, 1)); }
+/* local -> world, in long double */
+static inline lv3 fw_point(const frame *f, lv3 p)
+{
+    return L3((long double)f->P.x + f->e1.x * p.x + f->e2.x * p.y + f->A.x * p.z,
+              (long double)f->P.y + f->e1.y * p.x + f->e2.y * p.y + f->A.y * p.z,
+              (long double)f->P.z + f->e1.z * p.x + f->e2.z * p.y + f->A.z * p.z);
+}
+static inline lv3 fw_dir(const frame *f, lv3 d)
+{
+    return L3(f->e1.x * d.x + f->e2.x * d.y + f->A.x * d.z,
+              f->e1.y * d.x + f->e2.y * d.y + f->A.y * d.z,
+              f->e1.z * d.x + f->e2.z * d.y + f->A.z * d.z);
+}
+/* world -> local, in long double */
+static inline lv3 fl_point(const frame *f, lp_vec3 w)
+{
+    lv3 d = L3((long double)w.x - f->P.x, (long double)w.y - f->P.y, (long double)w.z - f->P.z);
+    return L3(d.x * f->e1.x + d.y * f->e1.y + d.z * f->e1.z,
+              d.x * f->e2.x + d.y * f->e2.y + d.z * f->e2.z,
+              d.x * f->A.x + d.y * f->A.y + d.z * f->A.z);
+}
+static inline lv3 fl_dir(const frame *f, lp_vec3 w)
+{
+    lv3 d = lfrom(w);
+    return L3(d.x * f->e1.x + d.y * f->e1.y + d.z * f->e1.z,
+              d.x * f->e2.x + d.y * f->e2.y + d.z * f->e2.z,
+              d.x * f->A.x + d.y * f->A.y + d.z * f->A.z);
+}
+
+static inline int has_word(const char *msg, const char *word)
+{
+    size_t n = strlen(word);
+    for (const char *p = msg; *p; p++) {
+        size_t i = 0;
+        while (i < n && p[i] && (p[i] | 0x20) == (word[i] | 0x20))
+            i++;
+        if (i == n)
+            return 1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* reference lens geometry, long double, local frame                   */
+/* ------------------------------------------------------------------ */
+
+typedef struct {
+    long double c1, c2, t, a1, a2, zf, zb, k;
+    int rim;
+    double size;
+} ref_lens;
+
+static inline long double curv(double R) { return (R == 0.0 || isinf(R)) ? 0.0L : 1.0L / (long double)R; }
+/* sag(h) = R - sign(R) sqrt(R^2 - h^2), written without cancellation:
+ * c h^2 / (1 + sqrt(1 - c^2 h^2)), c = 1/R (0 for flat). */
+static inline long double rsag(long double c, long double h)
+{
+    return c * h * h / (1.0L + sqrtl(1.0L - c * c * h * h));
+}
+
+static inline void ref_init(ref_lens *L, double R1, double R2, double t, double D, double D2)
+{
+    L->c1 = curv(R1);
+    L->c2 = curv(R2);
+    L->t = t;
+    L->a1 = D / 2;
+    L->a2 = (D2 > 0 ? D2 : D) / 2;
+    L->zf = rsag(L->c1, L->a1);
+    L->zb = t + rsag(L->c2, L->a2);
+    double zmin = (double)fminl(0.0L, L->zf), zmax = (double)fmaxl(t, L->zb);
+    L->size = fmax(fmax(D, D2), zmax - zmin);
+    L->rim = (L->zb - L->zf) > 1e-12L * L->size;
+    L->k = L->rim ? (L->a2 - L->a1) / (L->zb - L->zf) : 0.0L;
+}
+
+typedef struct {
+    long double s;
+    lv3 p, n;
+    int surf;
+} ref_hit;
+
+/* roots of A s^2 + 2 B s + C = 0 (stable form) */
+static inline int quad_roots(long double A, long double B, long double C, long double r[2])
+{
+    if (A == 0.0L) {
+        if (B == 0.0L)
+            return 0;
+        r[0] = -C / (2.0L * B);
+        return 1;
+    }
+    long double disc = B * B - A * C;
+    if (disc < 0.0L)
+        return 0;
+    long double q = -(B + copysignl(sqrtl(disc), B));
+    if (q == 0.0L) {
+        r[0] = 0.0L;
+        return 1;
+    }
+    r[0] = q / A;
+    r[1] = C / q;
+    return 2;
+}
+
+static inline void consider(ref_hit *best, long double s, lv3 p, lv3 n, int surf)
+{
+    if (best->surf < 0 || s < best->s) {
+        best->s = s;
+        best->p = p;
+        best->n = n;
+        best->surf = surf;
+    }
+}
+
+/* Nearest surface hit of O + s d, s > smin (d unit). surf -1: none. */
+static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, long double smin)
+{
+    ref_hit best;
+    best.surf = -1;
+    best.s = 0;
+    for (int side = 0; side < 2; side++) {
+        long double c = side ? L->c2 : L->c1, z0 = side ? L->t : 0.0L, a = side ? L->a2 : L->a1;
+        long double Z = O.z - z0;
+        long double A = c, B = c * (O.x * d.x + O.y * d.y + Z * d.z) - d.z;
+        long double C = c * (O.x * O.x + O.y * O.y + Z * Z) - 2.0L * Z;
+        long double r[2];
+        int nr = quad_roots(A, B, C, r);
+        for (int i = 0; i < nr; i++) {
+            if (!(r[i] > smin))
+                continue;
+            lv3 p = ladd(O, lscale(d, r[i]));
+            if (p.x * p.x + p.y * p.y > a * a)
+                continue;
+            if (c * (p.z - z0) >= 1.0L)
+                continue;
+            /* outward normal: front +grad G1, back -grad G2 */
+            lv3 g = L3(c * p.x, c * p.y, c * (p.z - z0) - 1.0L);
+            lv3 n = lnorm(side ? lscale(g, -1.0L) : g);
+            consider(&best, r[i], p, n, side ? LP_SURFACE_BACK : LP_SURFACE_FRONT);
+        }
+    }
+    if (L->rim) {
+        long double R0 = L->a1 + L->k * (O.z - L->zf);
+        long double A = d.x * d.x + d.y * d.y - L->k * L->k * d.z * d.z;
+        long double B = O.x * d.x + O.y * d.y - R0 * L->k * d.z;
+        long double C = O.x * O.x + O.y * O.y - R0 * R0;
+        long double r[2];
+        int nr = quad_roots(A, B, C, r);
+        for (int i = 0; i < nr; i++) {
+            if (!(r[i] > smin))
+                continue;
+            lv3 p = ladd(O, lscale(d, r[i]));
+            if (p.z < L->zf || p.z > L->zb)
+                continue;
+            long double rr = L->a1 + L->k * (p.z - L->zf);
+            lv3 n = lnorm(L3(p.x, p.y, -rr * L->k));
+            consider(&best, r[i], p, n, LP_SURFACE_RIM);
+        }
+    }
+    return best;
+}
+
+/* Inside test with a margin (a lower bound-ish of the distance to the
+ * boundary, vertical for the caps). */
+static inline int ref_inside(const ref_lens *L, lv3 p, long double *margin)
+{
+    long double r = sqrtl(p.x * p.x + p.y * p.y);
+    long double rmax = fmaxl(L->a1, L->a2);
+    if (r >= rmax) {
+        *margin = r - rmax;
+        return 0;
+    }
+    long double lower, upper;
+    if (r <= L->a1)
+        lower = rsag(L->c1, r);
+    else
+        lower = L->zf + (r - L->a1) / L->k; /* cone, a2 > a1 */
+    if (r <= L->a2)
+        upper = L->t + rsag(L->c2, r);
+    else
+        upper = L->zf + (r - L->a1) / L->k; /* cone, a1 > a2 */
+    long double m = fminl(fabsl(p.z - lower), fabsl(p.z - upper));
+    m = fminl(m, rmax - r);
+    *margin = m;
+    return p.z > lower && p.z < upper;
+}
+
+/* ------------------------------------------------------------------ */
+/* random valid lenses of every family                                 */
+/* ------------------------------------------------------------------ */
+
+typedef struct {
+    double R1, R2, t, D, D2;
+    int family;
+} rshape;
+
+static const char *const family_names[] = {
+    "biconvex",       "plano-convex",    "convex-plano", "positive meniscus", "negative meniscus",
+    "meniscus (R<0)", "plano-concave",   "concave-plano", "biconcave",        "flat plate",
+    "knife edge",     "cone narrowing", "cone widening"};
+
+/* sag of a cap of radius R at height h (double; 0 for flat) */
+static inline double dsag(double R, double h)
+{
+    if (R == 0.0 || isinf(R))
+        return 0.0;
+    return h * h / (R * (1.0 + sqrt(1.0 - (h / R) * (h / R))));
+}
+
+/* a radius magnitude with a/|R| in [0.1, 0.95] */
+static inline double rad_for(double a) { return a / urange(0.1, 0.95); }
+
+static inline void random_shape(rshape *s)
+{
+    int fam = (int)(sm64() % 13);
+    double D = urange(5, 50), a = D / 2;
+    double edge = urand() < 0.1 ? urange(0.005, 0.05) : urange(0.3, 0.3 * D);
+    double R1 = INFINITY, R2 = INFINITY, D2 = 0, x, y;
+    s->family = fam;
+    switch (fam) {
+    case 0: R1 = rad_for(a); R2 = -rad_for(a); break;
+    case 1: R1 = rad_for(a); R2 = INFINITY; break;
+    case 2: R1 = 0; R2 = -rad_for(a); break;
+    case 3: x = rad_for(a); y = rad_for(a); R1 = fmin(x, y); R2 = fmax(x, y); break;
+    case 4: x = rad_for(a); y = rad_for(a); R1 = fmax(x, y); R2 = fmin(x, y); break;
+    case 5: R1 = -rad_for(a); R2 = -rad_for(a); break;
+    case 6: R1 = -rad_for(a); R2 = INFINITY; break;
+    case 7: R1 = -INFINITY; R2 = rad_for(a); break;
+    case 8: R1 = -rad_for(a); R2 = rad_for(a); break;
+    case 9: R1 = (sm64() & 1) ? 0.0 : INFINITY; R2 = (sm64() & 1) ? 0.0 : -INFINITY; break;
+    case 10: {
+        /* exact knife edges: sag(3) = 5 - 4 = 1 for R = 5 and 3.75 - 2.25
+         * = 1.5 for R = 3.75, scaled by powers of two (exact) */
+        double sc = ldexp(1.0, (int)(sm64() % 5) - 1);
+        int v = (int)(sm64() % 3);
+        s->D = 6 * sc;
+        s->D2 = 0;
+        s->R1 = 5 * sc;
+        s->R2 = v == 0 ? -5 * sc : (v == 1 ? -3.75 * sc : INFINITY);
+        s->t = (v == 0 ? 2 : (v == 1 ? 2.5 : 1)) * sc;
+        return;
+    }
+    case 11:
+        R1 = rad_for(a);
+        D2 = D * urange(0.5, 0.9);
+        R2 = urand() < 0.3 ? INFINITY : -rad_for(D2 / 2);
+        break;
+    case 12: {
+        D2 = D * urange(1.1, 1.6);
+        R2 = -rad_for(D2 / 2);
+        int v = (int)(sm64() % 3);
+        R1 = v == 0 ? rad_for(a) : (v == 1 ? INFINITY : -rad_for(a));
+        break;
+    }
+    }
+    double a2 = (D2 > 0 ? D2 : D) / 2;
+    s->R1 = R1;
+    s->R2 = R2;
+    s->D = D;
+    s->D2 = D2;
+    s->t = fmax(dsag(R1, a) - dsag(R2, a2), 0.0) + edge;
+}
+
+static inline lp_lens *make_lens_g(const rshape *s, const lp_glass *glass, const lp_glass *medium,
+                                   const frame *f)
+{
+    lp_lens_desc desc;
+    lp_lens_desc_init(&desc);
+    desc.radius1 = s->R1;
+    desc.radius2 = s->R2;
+    desc.thickness = s->t;
+    desc.diameter = s->D;
+    desc.diameter2 = s->D2;
+    if (glass)
+        desc.glass = *glass;
+    if (medium)
+        desc.medium = *medium;
+    desc.position = f->P;
+    desc.axis = f->A;
+    lp_lens *lens = NULL;
+    lp_error err;
+    lp_status st = lp_lens_create(&desc, &lens, &err);
+    CHECK(st == LP_OK, "valid %s lens R1=%.17g R2=%.17g t=%.17g D=%.17g D2=%.17g refused: %s",
+          family_names[s->family], s->R1, s->R2, s->t, s->D, s->D2, err.message);
+    return st == LP_OK ? lens : NULL;
+}
+
+static const char *const builtin_names[] = {"N-BK7", "N-SF11", "F2",  "N-BAK4",
+                                            "N-SF6", "FUSED-SILICA", "CAF2"};
+
+/* A random glass: a catalog glass (absorbing) or a constant 1.3..2.0. */
+static inline void random_glass(lp_glass *g)
+{
+    if (sm64() & 1) {
+        const char *name = builtin_names[sm64() % (sizeof builtin_names / sizeof builtin_names[0])];
+        lp_error err;
+        lp_status st = lp_glass_builtin(name, g, &err);
+        CHECK(st == LP_OK, "lp_glass_builtin(\"%s\"): %s", name, err.message);
+        if (st == LP_OK)
+            return;
+    }
+    lp_glass_init_constant(g, urange(1.3, 2.0));
+}
+
+static inline void random_medium(lp_glass *g)
+{
+    lp_glass_init_constant(g, (sm64() & 1) ? 1.0 : urange(1.0, 1.4));
+}
+
+/* A random point on (or near) the lens surface, local frame. */
+static inline lv3 random_surface_point(const ref_lens *L, int which)
+{
+    long double phi = urange(0, 2 * M_PI);
+    if (which == 2 && L->rim) {
+        long double u = urand();
+        long double z = L->zf + u * (L->zb - L->zf), r = L->a1 + u * (L->a2 - L->a1);
+        return L3(r * cosl(phi), r * sinl(phi), z);
+    }
+    int back = which == 1;
+    long double a = back ? L->a2 : L->a1, r = sqrtl(urand()) * a;
+    long double z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
+    return L3(r * cosl(phi), r * sinl(phi), z);
+}
+
+/* ------------------------------------------------------------------ */
+/* optics written here: refraction, Fresnel amplitudes, Jones transport */
+/* ------------------------------------------------------------------ */
+
+#include <complex.h>
+
+typedef long double complex lcx;
+typedef struct { lcx x, y, z; } cv3;
+
+static cv3 cv_from(lv3 a) { cv3 r = {a.x, a.y, a.z}; return r; }
+static lcx cv_dot_real(cv3 a, lv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static cv3 cv_comb(lcx s, lv3 a, lcx p, lv3 b)
+{
+    cv3 r = {s * a.x + p * b.x, s * a.y + p * b.y, s * a.z + p * b.z};
+    return r;
+}
+static cv3 cv_scale(cv3 a, lcx s) { cv3 r = {a.x * s, a.y * s, a.z * s}; return r; }
+static cv3 cv_add(cv3 a, cv3 b) { cv3 r = {a.x + b.x, a.y + b.y, a.z + b.z}; return r; }
+static long double cv_norm2(cv3 a)
+{
+    return creall(a.x * conjl(a.x) + a.y * conjl(a.y) + a.z * conjl(a.z));
+}
+static lv3 lcross(lv3 a, lv3 b)
+{
+    return L3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static lv3 lreflect(lv3 d, lv3 n) { return ladd(d, lscale(n, -2 * ldot(d, n))); }
+
+/* Snell: d hits a surface with (either-sided) normal n from index n1 into
+ * n2; 0 under TIR. */
+static int lrefract(lv3 d, lv3 n, long double n1, long double n2, lv3 *out)
+{
+    lv3 m = ldot(d, n) < 0 ? n : lscale(n, -1); /* toward the incident side */
+    long double ci = -ldot(d, m), eta = n1 / n2;
+    long double st2 = eta * eta * (1 - ci) * (1 + ci);
+    if (st2 >= 1)
+        return 0;
+    long double ct = sqrtl(1 - st2);
+    *out = lnorm(ladd(lscale(d, eta), lscale(m, eta * ci - ct)));
+    return 1;
+}
+
+/* Born & Wolf amplitudes for the basis s, p = k x s of each wave; time
+ * dependence exp(-i w t), so under TIR n2 cos_t = +i sqrt(n1^2 sin^2 - n2^2). */
+typedef struct {
+    int tir;
+    lcx rs, rp;
+    long double ts, tp; /* power-normalized: ts^2 = 1 - |rs|^2 */
+    long double Rs, Rp, ct;
+} fres;
+
+static fres fresnel(long double ci, long double n1, long double n2)
+{
+    fres f;
+    long double st2 = (n1 / n2) * (n1 / n2) * (1 - ci) * (1 + ci);
+    if (st2 >= 1) {
+        long double q = sqrtl(n1 * n1 * (1 - ci) * (1 + ci) - n2 * n2);
+        f.tir = 1;
+        f.rs = (n1 * ci - I * q) / (n1 * ci + I * q);
+        f.rp = (n2 * n2 * ci - I * n1 * q) / (n2 * n2 * ci + I * n1 * q);
+        f.ts = f.tp = 0;
+        f.Rs = f.Rp = 1;
+        f.ct = -1;
+        return f;
+    }
+    long double ct = sqrtl(1 - st2);
+    long double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
+    long double rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
+    f.tir = 0;
+    f.rs = rs;
+    f.rp = rp;
+    f.Rs = rs * rs;
+    f.Rp = rp * rp;
+    f.ts = sqrtl(1 - f.Rs);
+    f.tp = sqrtl(1 - f.Rp);
+    f.ct = ct;
+    return f;
+}
+
+/* Reflectance of a node for a mode's unpolarized law (fresnel, schlick). */
+static long double mode_R(lp_mode mode, long double ci, long double n1, long double n2)
+{
+    fres f = fresnel(ci, n1, n2);
+    if (f.tir)
+        return 1;
+    if (mode == LP_MODE_SCHLICK) {
+        long double R0 = ((n1 - n2) / (n1 + n2)) * ((n1 - n2) / (n1 + n2));
+        long double c = n1 <= n2 ? ci : f.ct;
+        return R0 + (1 - R0) * powl(1 - c, 5);
+    }
+    return (f.Rs + f.Rp) / 2;
+}
+
+/* One node in the direction of light: field E on k_in leaves along k_out
+ * (reflected or transmitted) at a surface with normal n. */
+static cv3 jones_node(cv3 E, lv3 k_in, lv3 k_out, lv3 n, long double n1, long double n2, int reflect)
+{
+    long double ci = fabsl(ldot(k_in, n));
+    lv3 s = lcross(k_in, n);
+    if (llen(s) < 1e-12L) { /* normal incidence: any s */
+        lv3 h = fabsl(k_in.x) < 0.6L ? L3(1, 0, 0) : L3(0, 1, 0);
+        s = lcross(k_in, h);
+    }
+    s = lnorm(s);
+    lv3 p_in = lcross(k_in, s), p_out = lcross(k_out, s);
+    lcx Es = cv_dot_real(E, s), Ep = cv_dot_real(E, p_in);
+    fres f = fresnel(ci, n1, n2);
+    if (reflect)
+        return cv_comb(f.rs * Es, s, f.rp * Ep, p_out);
+    return cv_comb(f.ts * Es, s, f.tp * Ep, p_out);
+}
+
+/* ------------------------------------------------------------------ */
+/* the view ray's chain through the lens (long double reference)       */
+/* ------------------------------------------------------------------ */
+
+#define MAXN 24
+typedef struct {
+    int n;                                   /* cap nodes 1..n */
+    lv3 p[MAXN + 2], nrm[MAXN + 2], din[MAXN + 2], drefl[MAXN + 2], dtran[MAXN + 2];
+    int surf[MAXN + 2], tir[MAXN + 2], good[MAXN + 2];
+    long double seg[MAXN + 2];               /* internal length node k-1 -> k */
+    long double cosi[MAXN + 2];
+    int rim_depth;                           /* node index of the rim, 0 none */
+    int leak;
+} chain;
+
+static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O, lv3 d, chain *c)
+{
+    memset(c, 0, sizeof *c);
+    ref_hit h = ref_intersect(L, O, d, 0.0L);
+    if (h.surf < 0)
+        return;
+    if (h.surf == LP_SURFACE_RIM) {
+        c->rim_depth = 1;
+        return;
+    }
+    lv3 dir = d;
+    long double n1 = nm, n2 = ng;
+    long double edge_m = 1e-6L * L->size;
+    for (int k = 1; k <= MAXN; k++) {
+        c->n = k;
+        c->p[k] = h.p;
+        c->nrm[k] = h.n;
+        c->surf[k] = h.surf;
+        c->din[k] = dir;
+        long double ci = fabsl(ldot(dir, h.n));
+        c->cosi[k] = ci;
+        c->drefl[k] = lreflect(dir, h.n);
+        c->tir[k] = !lrefract(dir, h.n, n1, n2, &c->dtran[k]);
+        /* conditioning: away from the cap's edge circle, not grazing, not
+         * near the critical angle */
+        long double a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
+        long double r = sqrtl(h.p.x * h.p.x + h.p.y * h.p.y);
+        long double x = (n1 / n2) * sqrtl((1 - ci) * (1 + ci)); /* sin of refraction */
+        int good = r < a - edge_m && ci > 0.02L && fabsl(x - 1) > 1e-3L;
+        if (!c->tir[k])
+            good = good && sqrtl((1 - x) * (1 + x)) > 0.02L;
+        c->good[k] = good;
+        lv3 next;
+        if (k == 1) {
+            if (c->tir[1])
+                return;
+            next = c->dtran[1];
+            n1 = ng;
+            n2 = nm;
+        } else {
+            next = c->drefl[k];
+        }
+        h = ref_intersect(L, h.p, next, 1e-9L * L->size);
+        if (h.surf < 0) {
+            c->leak = 1;
+            return;
+        }
+        if (h.surf == LP_SURFACE_RIM) {
+            c->rim_depth = k + 1;
+            return;
+        }
+        c->seg[k + 1] = h.s;
+        dir = next;
+    }
+}
+
+/* Follow light along the reverse of the chain from node k to node 1,
+ * starting at S along u0; 0 if it takes another route. */
+static int follow(const ref_lens *L, const chain *c, int k, long double ng, long double nm, lv3 S,
+                  lv3 u0, lv3 *exit_p, lv3 *exit_d)
+{
+    ref_hit h = ref_intersect(L, S, u0, 0.0L);
+    if (h.surf != c->surf[k])
+        return 0;
+    if (k == 1) {
+        *exit_p = h.p;
+        *exit_d = lreflect(u0, h.n);
+        return 1;
+    }
+    lv3 dir;
+    if (!lrefract(u0, h.n, nm, ng, &dir))
+        return 0;
+    lv3 p = h.p;
+    for (int j = k - 1; j >= 1; j--) {
+        h = ref_intersect(L, p, dir, 1e-9L * L->size);
+        if (h.surf != c->surf[j])
+            return 0;
+        p = h.p;
+        if (j > 1)
+            dir = lreflect(dir, h.n);
+        else if (!lrefract(dir, h.n, ng, nm, &dir))
+            return 0;
+    }
+    *exit_p = p;
+    *exit_d = dir;
+    return 1;
+}
+
+/* optical path inside the lens along query k's path */
+static long double chain_op(const chain *c, int k, long double ng)
+{
+    long double L = 0;
+    for (int j = 2; j <= k; j++)
+        L += c->seg[j];
+    return ng * L;
+}
+static long double chain_len(const chain *c, int k)
+{
+    long double L = 0;
+    for (int j = 2; j <= k; j++)
+        L += c->seg[j];
+    return L;
+}
+
+/* The exact field leaving at the view ray's entry point along -d for
+ * light arriving along -(query k dir) with field vp (unit, real), without
+ * the propagation phase and absorption. */
+static cv3 chain_jones(const chain *c, int k, long double ng, long double nm, lv3 vp, lv3 view_d)
+{
+    cv3 E = cv_from(vp);
+    if (k == 1)
+        return jones_node(E, lscale(c->drefl[1], -1), lscale(view_d, -1), c->nrm[1], nm, ng, 1);
+    /* node k: from outside into the glass */
+    E = jones_node(E, lscale(c->dtran[k], -1), lscale(c->din[k], -1), c->nrm[k], nm, ng, 0);
+    for (int j = k - 1; j >= 2; j--)
+        E = jones_node(E, lscale(c->drefl[j], -1), lscale(c->din[j], -1), c->nrm[j], ng, nm, 1);
+    return jones_node(E, lscale(c->dtran[1], -1), lscale(view_d, -1), c->nrm[1], ng, nm, 0);
+}
+
+/* unpolarized (or polarized bound) power transmittance of query k's path,
+ * without absorption */
+static long double chain_power(const chain *c, int k, long double ng, long double nm, lp_mode mode,
+                               int bound)
+{
+    long double P = 1;
+    for (int j = 1; j <= k; j++) {
+        long double n1 = j == 1 ? nm : ng, n2 = j == 1 ? ng : nm;
+        int reflect = (k == 1) || (j > 1 && j < k);
+        long double R;
+        if (bound) {
+            fres f = fresnel(c->cosi[j], n1, n2);
+            R = reflect ? fmaxl(f.Rs, f.Rp) : fminl(f.Rs, f.Rp);
+        } else {
+            R = mode_R(mode, c->cosi[j], n1, n2);
+        }
+        P *= reflect ? R : 1 - R;
+    }
+    return P;
+}
+
+static uint64_t chain_path(int d) { return d == 1 ? 1u : (((uint64_t)1 << (d - 1)) - 2); }
+static uint64_t reverse_path(uint64_t p, int d)
+{
+    uint64_t r = 0;
+    for (int j = 0; j < d; j++)
+        if (p >> j & 1)
+            r |= (uint64_t)1 << (d - 1 - j);
+    return r;
+}
+
+/* ------------------------------------------------------------------ */
+
+static const uint64_t SEED = 0x2ec1b0c17eULL;
+static char ctx[256];
+
+typedef struct {
+    long compared, skipped_cond, skipped_sens, queries, view_rays, tir_paths;
+    double worst_field_fb, worst_field_ref, worst_int_fb, worst_op;
+} stats;
+static stats st_pol, st_unp;
+
+static lv3 rand_perp(lv3 u)
+{
+    lv3 v;
+    do {
+        v = lfrom(rand_unit());
+        v = lsub(v, lscale(u, ldot(v, u)));
+    } while (llen(v) < 0.1L);
+    return lnorm(v);
+}
+
+/* field sum of a set of rays, phase relative to op_ref (mm), corrected to
+ * the reference exit point E along the ray (first order, Malus-Dupin) */
+static cv3 field_sum(const lp_out_ray *const *rays, int n, const frame *f, long double op_ref,
+                     long double lambda_mm, long double nm, lv3 E_ref, long double *op_out)
+{
+    cv3 sum = {0, 0, 0};
+    for (int i = 0; i < n; i++) {
+        const lp_ray *r = &rays[i]->ray;
+        lv3 o = fl_point(f, r->origin), d = fl_dir(f, r->dir);
+        long double op = r->op + nm * ldot(lsub(E_ref, o), d);
+        if (op_out)
+            *op_out = op;
+        long double phi = 2 * M_PI * (op - op_ref) / lambda_mm - M_PI * r->kphi + r->phase;
+        lcx a = sqrtl((long double)r->intensity) * cexpl(I * phi);
+        sum = cv_add(sum, cv_scale(cv_from(fl_dir(f, r->vp)), a));
+    }
+    return sum;
+}
+
+static long double cv_dist(cv3 a, cv3 b)
+{
+    cv3 d = {a.x - b.x, a.y - b.y, a.z - b.z};
+    return sqrtl(cv_norm2(d));
+}
+
+static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
+{
+    rng_state = SEED + (uint64_t)li * 0x9E3779B97F4A7C15ULL + (uint64_t)mode;
+    rshape s;
+    random_shape(&s);
+    long double ng = urange(1.3, 2.0), nm = (sm64() & 1) ? 1.0 : urange(1.0, 1.4);
+    lp_glass glass, medium;
+    lp_glass_init_constant(&glass, (double)ng);
+    long double alpha = 0;
+    if (sm64() & 1) { /* absorbing: tau = 0.5..0.99 over 10 mm, flat in lambda */
+        double tau = urange(0.5, 0.99);
+        glass.n_tau = 2;
+        glass.tau_lambda_nm[0] = 300;
+        glass.tau_lambda_nm[1] = 900;
+        glass.tau[0] = glass.tau[1] = tau;
+        glass.tau_thickness_mm = 10;
+        alpha = -logl(tau) / 10;
+        lp_error gerr;
+        CHECK(lp_glass_check(&glass, &gerr) == LP_OK, "hand-made absorbing glass: %s", gerr.message);
+    }
+    lp_glass_init_constant(&medium, (double)nm);
+    frame f = frame_make(V(urange(-20, 20), urange(-20, 20), urange(-20, 20)), rand_unit());
+    ref_lens L;
+    ref_init(&L, s.R1, s.R2, s.t, s.D, s.D2);
+    lp_lens *lens = make_lens_g(&s, &glass, &medium, &f);
+    if (!lens)
+        return;
+    lp_trace_args args;
+    lp_trace_args_init(&args);
+    args.mode = mode;
+    args.max_depth = 2 + (int)(sm64() % 5);
+    lp_result g, fw;
+    lp_result_init(&g);
+    lp_result_init(&fw);
+    for (int vi = 0; vi < 3; vi++) {
+        /* a view ray entering a random cap point from outside */
+        int back = (int)(sm64() & 1);
+        lv3 T = random_surface_point(&L, back);
+        if (sqrtl(T.x * T.x + T.y * T.y) > 0.9L * (back ? L.a2 : L.a1))
+            continue;
+        lv3 nT = lnorm(back ? lscale(L3(L.c2 * T.x, L.c2 * T.y, L.c2 * (T.z - L.t) - 1), -1)
+                            : L3(L.c1 * T.x, L.c1 * T.y, L.c1 * T.z - 1));
+        lv3 d;
+        do {
+            d = lfrom(rand_unit());
+        } while (ldot(d, nT) > -0.2L);
+        lp_vec3 Ow = lto(fw_point(&f, lsub(T, lscale(d, 2.0L * L.size))));
+        lp_vec3 dw = lto(fw_dir(&f, d));
+        double lambda = urange(380, 780);
+        long double lambda_mm = lambda * 1e-6L;
+        /* the reference chain from exactly the double view ray */
+        lv3 O = fl_point(&f, Ow);
+        d = lnorm(fl_dir(&f, dw));
+        chain c;
+        build_chain(&L, ng, nm, O, d, &c);
+        lp_error err;
+        lp_status stt = lp_backward_build(bw, lens, Ow, dw, lambda, &args, &err);
+        CHECK(stt == LP_OK, "backward_build: %s", err.message);
+        if (stt != LP_OK)
+            continue;
+        S->view_rays++;
+        size_t nq = lp_backward_query_count(bw);
+        const lp_query *qs = lp_backward_queries(bw);
+        int kmax = c.n < args.max_depth ? c.n : args.max_depth;
+        int kgood = 0;
+        while (kgood < kmax && c.good[kgood + 1])
+            kgood++;
+        if (c.n == 0) {
+            if (c.rim_depth == 1)
+                CHECK(nq == 0, "view ray on the rim: %zu queries", nq);
+            continue;
+        }
+        /* the queries up to kgood, one per depth, as the chain says */
+        int want_count = 0, got_count = 0;
+        for (int k = 1; k <= kgood; k++)
+            want_count += (k == 1) || !c.tir[k];
+        for (size_t qi = 0; qi < nq; qi++)
+            got_count += qs[qi].depth >= 1 && qs[qi].depth <= kgood;
+        snprintf(ctx, sizeof ctx, "[seed %#llx lens %d (%s) mode %d view %d]", (unsigned long long)SEED,
+                 li, family_names[s.family], (int)mode, vi);
+        CHECK(got_count == want_count, "%s: %d queries of depth <= %d, want %d", ctx, got_count, kgood,
+              want_count);
+        for (size_t qi = 0; qi < nq; qi++) {
+            const lp_query *q = &qs[qi];
+            int k = q->depth;
+            S->queries++;
+            if (k < 1 || k > kgood) {
+                S->skipped_cond++;
+                continue;
+            }
+            snprintf(ctx, sizeof ctx, "[seed %#llx lens %d (%s) mode %d view %d depth %d]",
+                     (unsigned long long)SEED, li, family_names[s.family], (int)mode, vi, k);
+            /* the query itself against the chain */
+            lv3 Qref = c.p[k], uref = k == 1 ? c.drefl[1] : c.dtran[k];
+            CHECK(!(k > 1 && c.tir[k]), "%s: query at a TIR node", ctx);
+            if (k > 1 && c.tir[k])
+                continue;
+            CHECK_ABS((double)llen(lsub(fl_point(&f, q->origin), Qref)) / L.size, 0.0, 1e-9,
+                      "%s: query origin vs reference chain", ctx);
+            CHECK_ABS((double)llen(lsub(fl_dir(&f, q->dir), uref)), 0.0, 1e-9,
+                      "%s: query dir vs reference chain", ctx);
+            CHECK(q->path == chain_path(k), "%s: query path %#llx want %#llx", ctx,
+                  (unsigned long long)q->path, (unsigned long long)chain_path(k));
+            CHECK(q->surface == c.surf[k], "%s: query surface %d want %d", ctx, q->surface, c.surf[k]);
+            CHECK(q->kind == (k == 1 || c.surf[k] == c.surf[1] ? LP_KIND_REFLECT : LP_KIND_TRANSMIT),
+                  "%s: query kind %d", ctx, (int)q->kind);
+            long double op_ref = chain_op(&c, k, ng);
+            long double absorb = expl(-alpha * chain_len(&c, k));
+            double tol_op = 1e-8 * (double)lambda_mm / (2 * M_PI);
+            CHECK_ABS(q->op, (double)op_ref, tol_op, "%s: query op (phase-equivalent 1e-8 rad)", ctx);
+            long double P_bound = chain_power(&c, k, ng, nm, mode, mode == LP_MODE_POLARIZED) * absorb;
+            CHECK_REL(q->bound, (double)P_bound, 1e-10, "%s: query bound vs Fresnel product", ctx);
+
+            /* conditioning of the reverse path: angular amplification */
+            long double s_off = 1e-3L * L.size;
+            ref_hit back_hit = ref_intersect(&L, Qref, uref, 1e-9L * L.size);
+            if (back_hit.surf >= 0 && back_hit.s < 4 * s_off)
+                s_off = back_hit.s / 4;
+            lv3 S0 = ladd(Qref, lscale(uref, s_off));
+            lv3 ep, ed, ep1, ed1;
+            int ok = follow(&L, &c, k, ng, nm, S0, lscale(uref, -1), &ep, &ed);
+            CHECK(ok && llen(lsub(ep, c.p[1])) < 1e-12L * L.size && llen(lsub(ed, lscale(d, -1))) < 1e-12L,
+                  "%s: (test self-check) reverse path does not retrace the chain", ctx);
+            long double G = 0;
+            lv3 e1 = rand_perp(uref), e2 = lnorm(lcross(uref, e1));
+            for (int pj = 0; pj < 2 && ok; pj++) {
+                const long double dl = 1e-7L;
+                lv3 u1 = lnorm(ladd(lscale(uref, -1), lscale(pj ? e2 : e1, dl)));
+                if (!follow(&L, &c, k, ng, nm, S0, u1, &ep1, &ed1)) {
+                    G = INFINITY;
+                    break;
+                }
+                G = fmaxl(G, llen(lsub(ed1, ed)) / dl);
+            }
+            if (!ok || G > 1e4L) {
+                S->skipped_sens++;
+                continue;
+            }
+
+            /* gather two bundle rays: the brief's plain one and one with a payload */
+            lp_ray bundle[2];
+            memset(bundle, 0, sizeof bundle);
+            lv3 vp[2];
+            for (int b = 0; b < 2; b++) {
+                vp[b] = rand_perp(uref);
+                bundle[b].lambda_nm = lambda;
+                bundle[b].vp = lto(fw_dir(&f, vp[b]));
+                bundle[b].dir = lto(fw_dir(&f, lscale(uref, -1)));
+                bundle[b].origin = q->origin;
+                bundle[b].ch = 1000 + (uint64_t)b;
+            }
+            bundle[0].intensity = 1;
+            bundle[1].intensity = urange(0.1, 5);
+            bundle[1].op = urange(0, 3);
+            bundle[1].kphi = (int)(sm64() % 4);
+            bundle[1].phase = urange(-3, 3);
+            lp_result_clear(&g);
+            stt = lp_backward_gather(bw, qi, bundle, 2, &g, &err);
+            CHECK(stt == LP_OK, "%s: gather: %s", ctx, err.message);
+            if (stt != LP_OK)
+                continue;
+            double bsum = bundle[0].intensity + bundle[1].intensity;
+            CHECK_REL(g.in, bsum, 1e-15, "%s: gather in = bundle intensity", ctx);
+            CHECK_REL(g.out + g.skipped + g.absorbed_glass + g.absorbed_rim + g.truncated, g.in, 1e-12,
+                      "%s: gather bookkeeping", ctx);
+            double gsum = 0;
+            for (size_t i = 0; i < g.count; i++)
+                gsum += g.rays[i].ray.intensity;
+            CHECK_REL(gsum, g.out, 1e-12, "%s: gather out = sum of its rays", ctx);
+            CHECK(g.count >= 2 && g.count <= 4, "%s: gather returned %zu rays for 2 bundle rays", ctx,
+                  g.count);
+            for (size_t i = 0; i < g.count; i++) {
+                const lp_out_ray *o = &g.rays[i];
+                CHECK(o->depth == k && o->kind == q->kind && o->path == q->path,
+                      "%s: gathered ray depth/kind/path", ctx);
+                CHECK_ABS((double)llen(lsub(fl_point(&f, o->ray.origin), c.p[1])) / L.size, 0.0, 1e-9,
+                          "%s: gathered ray leaves at the view ray's entry point", ctx);
+                CHECK_ABS((double)llen(lsub(fl_dir(&f, o->ray.dir), lscale(d, -1))), 0.0, 1e-12,
+                          "%s: gathered ray leaves along -view dir", ctx);
+                CHECK(o->ray.ch == 1000 || o->ray.ch == 1001, "%s: gathered ch not copied", ctx);
+                if (mode == LP_MODE_POLARIZED) {
+                    CHECK_ABS(vlen(o->ray.vp), 1.0, 1e-9, "%s: gathered |vp|", ctx);
+                    CHECK_ABS(vdot(o->ray.vp, o->ray.dir), 0.0, 1e-9, "%s: gathered vp . dir", ctx);
+                }
+            }
+
+            /* forward from just outside Q along -u, for each bundle ray */
+            uint64_t fpath = reverse_path(q->path, k);
+            for (int b = 0; b < 2; b++) {
+                lp_ray in = bundle[b];
+                in.origin = lto(fw_point(&f, S0));
+                in.dir = bundle[b].dir;
+                lp_trace_args fargs = args;
+                fargs.max_depth = k;
+                stt = lp_trace_forward(lens, &in, &fargs, &fw, &err);
+                CHECK(stt == LP_OK, "%s: forward: %s", ctx, err.message);
+                const lp_out_ray *fr[8], *gr[8];
+                int nf = 0, ng_ = 0;
+                for (size_t i = 0; i < fw.count && nf < 8; i++) {
+                    const lp_out_ray *o = &fw.rays[i];
+                    if (o->depth != k || o->path != fpath)
+                        continue;
+                    fr[nf++] = o;
+                }
+                for (size_t i = 0; i < g.count && ng_ < 8; i++)
+                    if (g.rays[i].ray.ch == bundle[b].ch)
+                        gr[ng_++] = &g.rays[i];
+                CHECK(nf >= 1 && nf <= 2, "%s: %d forward rays of depth %d path %#llx", ctx, nf, k,
+                      (unsigned long long)fpath);
+                CHECK(ng_ >= 1 && ng_ <= 2, "%s: %d gathered rays for bundle ray %d", ctx, ng_, b);
+                if (nf < 1 || ng_ < 1)
+                    continue;
+                int match = 1;
+                for (int i = 0; i < nf; i++) {
+                    lv3 o = fl_point(&f, fr[i]->ray.origin), dd = fl_dir(&f, fr[i]->ray.dir);
+                    match &= llen(lsub(o, c.p[1])) < 1e-7L * L.size && llen(lsub(dd, lscale(d, -1))) < 1e-7L;
+                    CHECK(fr[i]->kind == q->kind && fr[i]->surface == c.surf[1],
+                          "%s: forward ray kind %d surface %d", ctx, (int)fr[i]->kind, fr[i]->surface);
+                }
+                CHECK(match, "%s: the forward ray of depth %d does not leave at the view entry point "
+                             "along -d", ctx, k);
+                if (!match)
+                    continue;
+                S->compared++;
+                long double Ib = bundle[b].intensity;
+                if (mode == LP_MODE_POLARIZED) {
+                    long double opf = 0, opg = 0;
+                    long double op0 = op_ref + bundle[b].op;
+                    cv3 Ef = field_sum(fr, nf, &f, op0, lambda_mm, nm, c.p[1], &opf);
+                    cv3 Eg = field_sum(gr, ng_, &f, op0, lambda_mm, nm, c.p[1], &opg);
+                    /* the exact field, written here */
+                    cv3 Er = chain_jones(&c, k, ng, nm, vp[b], d);
+                    lcx a = sqrtl(Ib) * sqrtl(absorb) * cexpl(I * (-M_PI * bundle[b].kphi + bundle[b].phase));
+                    Er = cv_scale(Er, a);
+                    if (nf == 2 || ng_ == 2)
+                        S->tir_paths++;
+                    long double sc = sqrtl(Ib);
+                    double dfb = (double)(cv_dist(Ef, Eg) / sc), dref = (double)(cv_dist(Eg, Er) / sc);
+                    double dfr = (double)(cv_dist(Ef, Er) / sc);
+                    CHECK_ABS(dfb, 0.0, 1e-8, "%s: bundle %d: field forward vs gathered", ctx, b);
+                    CHECK_ABS(dref, 0.0, 1e-8, "%s: bundle %d: gathered field vs exact Jones field", ctx, b);
+                    CHECK_ABS(dfr, 0.0, 1e-8, "%s: bundle %d: forward field vs exact Jones field", ctx, b);
+                    long double If = cv_norm2(Ef), Ig = cv_norm2(Eg), Ir = cv_norm2(Er);
+                    CHECK_REL((double)Ig, (double)If, 1e-10, "%s: bundle %d: intensity gathered vs forward",
+                              ctx, b);
+                    CHECK_REL((double)Ig, (double)Ir, 1e-10, "%s: bundle %d: intensity vs exact", ctx, b);
+                    CHECK(Ig <= P_bound * Ib * (1 + 1e-10L), "%s: gathered intensity above the bound", ctx);
+                    CHECK_ABS((double)opg, (double)opf, tol_op, "%s: bundle %d: gathered op = forward op",
+                              ctx, b);
+                    CHECK_ABS((double)opg, (double)op0, tol_op, "%s: bundle %d: gathered op = bundle op + "
+                              "path op", ctx, b);
+                    S->worst_field_fb = fmax(S->worst_field_fb, dfb);
+                    S->worst_field_ref = fmax(S->worst_field_ref, fmax(dref, dfr));
+                    S->worst_int_fb = fmax(S->worst_int_fb, (double)(fabsl(Ig - If) / fmaxl(If, 1e-300L)));
+                    S->worst_op = fmax(S->worst_op, (double)fabsl(opg - opf));
+                    if (nf == 1 && ng_ == 1)
+                        CHECK_REL(gr[0]->ray.intensity, fr[0]->ray.intensity, 1e-10,
+                                  "%s: bundle %d: ray intensity gathered vs forward", ctx, b);
+                } else {
+                    double If = 0, Ig = 0;
+                    for (int i = 0; i < nf; i++)
+                        If += fr[i]->ray.intensity;
+                    for (int i = 0; i < ng_; i++)
+                        Ig += gr[i]->ray.intensity;
+                    long double want = Ib * chain_power(&c, k, ng, nm, mode, 0) * absorb;
+                    CHECK_REL(Ig, If, 1e-10, "%s: bundle %d: intensity gathered vs forward", ctx, b);
+                    CHECK_REL(Ig, (double)want, 1e-10, "%s: bundle %d: intensity vs %s product", ctx, b,
+                              mode == LP_MODE_FRESNEL ? "Fresnel" : "Schlick");
+                    CHECK_REL(Ig, q->bound * Ib, 1e-10, "%s: bundle %d: gathered = bound x I (exact "
+                              "transmittance in this mode)", ctx, b);
+                    S->worst_int_fb = fmax(S->worst_int_fb, fabs(Ig - If) / fmax(If, 1e-300));
+                }
+            }
+        }
+    }
+    lp_result_release(&g);
+    lp_result_release(&fw);
+    lp_lens_destroy(lens);
+}
+
+int main(void)
+{
+    lp_backward *bw = NULL;
+    lp_error err;
+    CHECK(lp_backward_create(&bw, &err) == LP_OK, "lp_backward_create: %s", err.message);
+    if (!bw)
+        return check_finish("test_reciprocity");
+    printf("test_reciprocity: seed %#llx\n", (unsigned long long)SEED);
+    for (int li = 0; li < 240; li++)
+        one_lens(li, bw, LP_MODE_POLARIZED, &st_pol);
+    for (int li = 0; li < 120; li++) {
+        one_lens(1000 + li, bw, LP_MODE_FRESNEL, &st_unp);
+        one_lens(2000 + li, bw, LP_MODE_SCHLICK, &st_unp);
+    }
+    printf("test_reciprocity: polarized: %ld view rays, %ld queries, %ld bundle rays compared "
+           "(%ld with TIR parts), skipped %ld ill-conditioned + %ld sensitive; worst |E_f - E_g| %.3g, "
+           "worst |E - E_exact| %.3g, worst intensity f/g %.3g, worst op diff %.3g mm\n",
+           st_pol.view_rays, st_pol.queries, st_pol.compared, st_pol.tir_paths, st_pol.skipped_cond,
+           st_pol.skipped_sens, st_pol.worst_field_fb, st_pol.worst_field_ref, st_pol.worst_int_fb,
+           st_pol.worst_op);
+    printf("test_reciprocity: fresnel+schlick: %ld view rays, %ld queries, %ld compared, skipped %ld + %ld; "
+           "worst intensity f/g %.3g\n",
+           st_unp.view_rays, st_unp.queries, st_unp.compared, st_unp.skipped_cond, st_unp.skipped_sens,
+           st_unp.worst_int_fb);
+    CHECK(st_pol.compared >= 1000, "enough polarized comparisons (%ld)", st_pol.compared);
+    CHECK(st_pol.tir_paths >= 10, "TIR paths among the comparisons (%ld)", st_pol.tir_paths);
+    CHECK(st_unp.compared >= 500, "enough unpolarized comparisons (%ld)", st_unp.compared);
+    lp_backward_destroy(bw);
+    lp_backward_destroy(NULL);
+    return check_finish("test_reciprocity");
+}

@@ -1,0 +1,934 @@
+/* test_rim.c -- the opaque rim (cylinder or cone).
+ *
+ * Rays aimed at the rim from outside give no output rays and
+ * absorbed_rim == in; for a conical rim (D = 30, D2 = 20) the cone's
+ * points, normals and containment follow the closed-form cone written
+ * here; a ray entering the front cap near its edge whose refracted path
+ * runs into the cone is absorbed at depth 2 with exactly the refracted
+ * power (1 - R) I (Fresnel computed here) and lp_backward_rim_depth = 2;
+ * on random lenses lp_backward_rim_depth equals the depth at which the
+ * reference chain (traced here in long double) meets the rim; rays
+ * through the exact cap/rim edge circle give finite results and a
+ * balanced bookkeeping.
+ */
+#include <float.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#include "lensprim.h"
+
+/* ------------------------------------------------------------------ */
+/* small helpers                                                       */
+/* ------------------------------------------------------------------ */
+
+static uint64_t rng_state = 0x1234abcd5678ef01ULL;
+static inline uint64_t sm64(void)
+{
+    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ULL);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    return z ^ (z >> 31);
+}
+static inline double urand(void) { return (double)(sm64() >> 11) * 0x1.0p-53; }
+static inline double urange(double a, double b) { return a + (b - a) * urand(); }
+
+static lp_vec3 V(double x, double y, double z) { lp_vec3 v = {x, y, z}; return v; }
+static inline lp_vec3 vadd(lp_vec3 a, lp_vec3 b) { return V(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline lp_vec3 vsub(lp_vec3 a, lp_vec3 b) { return V(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline lp_vec3 vscale(lp_vec3 a, double s) { return V(a.x * s, a.y * s, a.z * s); }
+static inline double vdot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline lp_vec3 vcross(lp_vec3 a, lp_vec3 b)
+{
+    return V(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline double vlen(lp_vec3 a) { return sqrt(vdot(a, a)); }
+static inline lp_vec3 vnorm(lp_vec3 a) { return vscale(a, 1.0 / vlen(a)); }
+static inline int vfinite(lp_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+static inline lp_vec3 rand_unit(void)
+{
+    for (;;) {
+        lp_vec3 v = V(urange(-1, 1), urange(-1, 1), urange(-1, 1));
+        double l = vlen(v);
+        if (l > 0.1 && l <= 1.0)
+            return vscale(v, 1.0 / l);
+    }
+}
+
+typedef struct { long double x, y, z; } lv3;
+static lv3 L3(long double x, long double y, long double z) { lv3 v = {x, y, z}; return v; }
+static inline lv3 ladd(lv3 a, lv3 b) { return L3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline lv3 lsub(lv3 a, lv3 b) { return L3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline lv3 lscale(lv3 a, long double s) { return L3(a.x * s, a.y * s, a.z * s); }
+static inline long double ldot(lv3 a, lv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline long double llen(lv3 a) { return sqrtl(ldot(a, a)); }
+static inline lv3 lnorm(lv3 a) { return lscale(a, 1.0L / llen(a)); }
+static inline lv3 lfrom(lp_vec3 a) { return L3(a.x, a.y, a.z); }
+static inline lp_vec3 lto(lv3 a) { return V((double)a.x, (double)a.y, (double)a.z); }
+
+/* A placement: world = P + e1*x + e2*y + A*z (A = the lens axis). */
+typedef struct { lp_vec3 P, e1, e2, A; } frame;
+
+static inline frame frame_make(lp_vec3 P, lp_vec3 A)
+{
+    frame f;
+    f.P = P;
+    f.A = vnorm(A);
+    lp_vec3 h = fabs(f.A.x) < 0.6 ? V(1, 0, 0) : (fabs(f.A.y) < 0.6 ? V(0, 1, 0) : V(0, 0, 1));
+    f.e1 = vnorm(vcross(f.A, h));
+    f.e2 = vcross(f.A, f.e1);
+    return f;
+}
+static inline frame frame_identity(void) { return frame_make(V(0, 0, 0), V(0, 0, 1)); }
+/* local -> world, in long double */
+static inline lv3 fw_point(const frame *f, lv3 p)
+{
+    return L3((long double)f->P.x + f->e1.x * p.x + f->e2.x * p.y + f->A.x * p.z,
+              (long double)f->P.y + f->e1.y * p.x + f->e2.y * p.y + f->A.y * p.z,
+              (long double)f->P.z + f->e1.z * p.x + f->e2.z * p.y + f->A.z * p.z);
+}
+static inline lv3 fw_dir(const frame *f, lv3 d)
+{
+    return L3(f->e1.x * d.x + f->e2.x * d.y + f->A.x * d.z,
+              f->e1.y * d.x + f->e2.y * d.y + f->A.y * d.z,
+              f->e1.z * d.x + f->e2.z * d.y + f->A.z * d.z);
+}
+/* world -> local, in long double */
+static inline lv3 fl_point(const frame *f, lp_vec3 w)
+{
+    lv3 d = L3((long double)w.x - f->P.x, (long double)w.y - f->P.y, (long double)w.z - f->P.z);
+    return L3(d.x * f->e1.x + d.y * f->e1.y + d.z * f->e1.z,
+              d.x * f->e2.x + d.y * f->e2.y + d.z * f->e2.z,
+              d.x * f->A.x + d.y * f->A.y + d.z * f->A.z);
+}
+static inline lv3 fl_dir(const frame *f, lp_vec3 w)
+{
+    lv3 d = lfrom(w);
+    return L3(d.x * f->e1.x + d.y * f->e1.y + d.z * f->e1.z,
+              d.x * f->e2.x + d.y * f->e2.y + d.z * f->e2.z,
+              d.x * f->A.x + d.y * f->A.y + d.z * f->A.z);
+}
+
+static inline int has_word(const char *msg, const char *word)
+{
+    size_t n = strlen(word);
+    for (const char *p = msg; *p; p++) {
+        size_t i = 0;
+        while (i < n && p[i] && (p[i] | 0x20) == (word[i] | 0x20))
+            i++;
+        if (i == n)
+            return 1;
+    }
+    return 0;
+}
+
+/* ------------------------------------------------------------------ */
+/* reference lens geometry, long double, local frame                   */
+/* ------------------------------------------------------------------ */
+
+typedef struct {
+    long double c1, c2, t, a1, a2, zf, zb, k;
+    int rim;
+    double size;
+} ref_lens;
+
+static inline long double curv(double R) { return (R == 0.0 || isinf(R)) ? 0.0L : 1.0L / (long double)R; }
+/* sag(h) = R - sign(R) sqrt(R^2 - h^2), written without cancellation:
+ * c h^2 / (1 + sqrt(1 - c^2 h^2)), c = 1/R (0 for flat). */
+static inline long double rsag(long double c, long double h)
+{
+    return c * h * h / (1.0L + sqrtl(1.0L - c * c * h * h));
+}
+
+static inline void ref_init(ref_lens *L, double R1, double R2, double t, double D, double D2)
+{
+    L->c1 = curv(R1);
+    L->c2 = curv(R2);
+    L->t = t;
+    L->a1 = D / 2;
+    L->a2 = (D2 > 0 ? D2 : D) / 2;
+    L->zf = rsag(L->c1, L->a1);
+    L->zb = t + rsag(L->c2, L->a2);
+    double zmin = (double)fminl(0.0L, L->zf), zmax = (double)fmaxl(t, L->zb);
+    L->size = fmax(fmax(D, D2), zmax - zmin);
+    L->rim = (L->zb - L->zf) > 1e-12L * L->size;
+    L->k = L->rim ? (L->a2 - L->a1) / (L->zb - L->zf) : 0.0L;
+}
+
+typedef struct {
+    long double s;
+    lv3 p, n;
+    int surf;
+} ref_hit;
+
+/* roots of A s^2 + 2 B s + C = 0 (stable form) */
+static inline int quad_roots(long double A, long double B, long double C, long double r[2])
+{
+    if (A == 0.0L) {
+        if (B == 0.0L)
+            return 0;
+        r[0] = -C / (2.0L * B);
+        return 1;
+    }
+    long double disc = B * B - A * C;
+    if (disc < 0.0L)
+        return 0;
+    long double q = -(B + copysignl(sqrtl(disc), B));
+    if (q == 0.0L) {
+        r[0] = 0.0L;
+        return 1;
+    }
+    r[0] = q / A;
+    r[1] = C / q;
+    return 2;
+}
+
+static inline void consider(ref_hit *best, long double s, lv3 p, lv3 n, int surf)
+{
+    if (best->surf < 0 || s < best->s) {
+        best->s = s;
+        best->p = p;
+        best->n = n;
+        best->surf = surf;
+    }
+}
+
+/* Nearest surface hit of O + s d, s > smin (d unit). surf -1: none. */
+static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, long double smin)
+{
+    ref_hit best;
+    best.surf = -1;
+    best.s = 0;
+    for (int side = 0; side < 2; side++) {
+        long double c = side ? L->c2 : L->c1, z0 = side ? L->t : 0.0L, a = side ? L->a2 : L->a1;
+        long double Z = O.z - z0;
+        long double A = c, B = c * (O.x * d.x + O.y * d.y + Z * d.z) - d.z;
+        long double C = c * (O.x * O.x + O.y * O.y + Z * Z) - 2.0L * Z;
+        long double r[2];
+        int nr = quad_roots(A, B, C, r);
+        for (int i = 0; i < nr; i++) {
+            if (!(r[i] > smin))
+                continue;
+            lv3 p = ladd(O, lscale(d, r[i]));
+            if (p.x * p.x + p.y * p.y > a * a)
+                continue;
+            if (c * (p.z - z0) >= 1.0L)
+                continue;
+            /* outward normal: front +grad G1, back -grad G2 */
+            lv3 g = L3(c * p.x, c * p.y, c * (p.z - z0) - 1.0L);
+            lv3 n = lnorm(side ? lscale(g, -1.0L) : g);
+            consider(&best, r[i], p, n, side ? LP_SURFACE_BACK : LP_SURFACE_FRONT);
+        }
+    }
+    if (L->rim) {
+        long double R0 = L->a1 + L->k * (O.z - L->zf);
+        long double A = d.x * d.x + d.y * d.y - L->k * L->k * d.z * d.z;
+        long double B = O.x * d.x + O.y * d.y - R0 * L->k * d.z;
+        long double C = O.x * O.x + O.y * O.y - R0 * R0;
+        long double r[2];
+        int nr = quad_roots(A, B, C, r);
+        for (int i = 0; i < nr; i++) {
+            if (!(r[i] > smin))
+                continue;
+            lv3 p = ladd(O, lscale(d, r[i]));
+            if (p.z < L->zf || p.z > L->zb)
+                continue;
+            long double rr = L->a1 + L->k * (p.z - L->zf);
+            lv3 n = lnorm(L3(p.x, p.y, -rr * L->k));
+            consider(&best, r[i], p, n, LP_SURFACE_RIM);
+        }
+    }
+    return best;
+}
+
+/* Inside test with a margin (a lower bound-ish of the distance to the
+ * boundary, vertical for the caps). */
+static inline int ref_inside(const ref_lens *L, lv3 p, long double *margin)
+{
+    long double r = sqrtl(p.x * p.x + p.y * p.y);
+    long double rmax = fmaxl(L->a1, L->a2);
+    if (r >= rmax) {
+        *margin = r - rmax;
+        return 0;
+    }
+    long double lower, upper;
+    if (r <= L->a1)
+        lower = rsag(L->c1, r);
+    else
+        lower = L->zf + (r - L->a1) / L->k; /* cone, a2 > a1 */
+    if (r <= L->a2)
+        upper = L->t + rsag(L->c2, r);
+    else
+        upper = L->zf + (r - L->a1) / L->k; /* cone, a1 > a2 */
+    long double m = fminl(fabsl(p.z - lower), fabsl(p.z - upper));
+    m = fminl(m, rmax - r);
+    *margin = m;
+    return p.z > lower && p.z < upper;
+}
+
+/* ------------------------------------------------------------------ */
+/* random valid lenses of every family                                 */
+/* ------------------------------------------------------------------ */
+
+typedef struct {
+    double R1, R2, t, D, D2;
+    int family;
+} rshape;
+
+static const char *const family_names[] = {
+    "biconvex",       "plano-convex",    "convex-plano", "positive meniscus", "negative meniscus",
+    "meniscus (R<0)", "plano-concave",   "concave-plano", "biconcave",        "flat plate",
+    "knife edge",     "cone narrowing", "cone widening"};
+
+/* sag of a cap of radius R at height h (double; 0 for flat) */
+static inline double dsag(double R, double h)
+{
+    if (R == 0.0 || isinf(R))
+        return 0.0;
+    return h * h / (R * (1.0 + sqrt(1.0 - (h / R) * (h / R))));
+}
+
+/* a radius magnitude with a/|R| in [0.1, 0.95] */
+static inline double rad_for(double a) { return a / urange(0.1, 0.95); }
+
+static inline void random_shape(rshape *s)
+{
+    int fam = (int)(sm64() % 13);
+    double D = urange(5, 50), a = D / 2;
+    double edge = urand() < 0.1 ? urange(0.005, 0.05) : urange(0.3, 0.3 * D);
+    double R1 = INFINITY, R2 = INFINITY, D2 = 0, x, y;
+    s->family = fam;
+    switch (fam) {
+    case 0: R1 = rad_for(a); R2 = -rad_for(a); break;
+    case 1: R1 = rad_for(a); R2 = INFINITY; break;
+    case 2: R1 = 0; R2 = -rad_for(a); break;
+    case 3: x = rad_for(a); y = rad_for(a); R1 = fmin(x, y); R2 = fmax(x, y); break;
+    case 4: x = rad_for(a); y = rad_for(a); R1 = fmax(x, y); R2 = fmin(x, y); break;
+    case 5: R1 = -rad_for(a); R2 = -rad_for(a); break;
+    case 6: R1 = -rad_for(a); R2 = INFINITY; break;
+    case 7: R1 = -INFINITY; R2 = rad_for(a); break;
+    case 8: R1 = -rad_for(a); R2 = rad_for(a); break;
+    case 9: R1 = (sm64() & 1) ? 0.0 : INFINITY; R2 = (sm64() & 1) ? 0.0 : -INFINITY; break;
+    case 10: {
+        /* exact knife edges: sag(3) = 5 - 4 = 1 for R = 5 and 3.75 - 2.25
+         * = 1.5 for R = 3.75, scaled by powers of two (exact) */
+        double sc = ldexp(1.0, (int)(sm64() % 5) - 1);
+        int v = (int)(sm64() % 3);
+        s->D = 6 * sc;
+        s->D2 = 0;
+        s->R1 = 5 * sc;
+        s->R2 = v == 0 ? -5 * sc : (v == 1 ? -3.75 * sc : INFINITY);
+        s->t = (v == 0 ? 2 : (v == 1 ? 2.5 : 1)) * sc;
+        return;
+    }
+    case 11:
+        R1 = rad_for(a);
+        D2 = D * urange(0.5, 0.9);
+        R2 = urand() < 0.3 ? INFINITY : -rad_for(D2 / 2);
+        break;
+    case 12: {
+        D2 = D * urange(1.1, 1.6);
+        R2 = -rad_for(D2 / 2);
+        int v = (int)(sm64() % 3);
+        R1 = v == 0 ? rad_for(a) : (v == 1 ? INFINITY : -rad_for(a));
+        break;
+    }
+    }
+    double a2 = (D2 > 0 ? D2 : D) / 2;
+    s->R1 = R1;
+    s->R2 = R2;
+    s->D = D;
+    s->D2 = D2;
+    s->t = fmax(dsag(R1, a) - dsag(R2, a2), 0.0) + edge;
+}
+
+static inline lp_lens *make_lens_g(const rshape *s, const lp_glass *glass, const lp_glass *medium,
+                                   const frame *f)
+{
+    lp_lens_desc desc;
+    lp_lens_desc_init(&desc);
+    desc.radius1 = s->R1;
+    desc.radius2 = s->R2;
+    desc.thickness = s->t;
+    desc.diameter = s->D;
+    desc.diameter2 = s->D2;
+    if (glass)
+        desc.glass = *glass;
+    if (medium)
+        desc.medium = *medium;
+    desc.position = f->P;
+    desc.axis = f->A;
+    lp_lens *lens = NULL;
+    lp_error err;
+    lp_status st = lp_lens_create(&desc, &lens, &err);
+    CHECK(st == LP_OK, "valid %s lens R1=%.17g R2=%.17g t=%.17g D=%.17g D2=%.17g refused: %s",
+          family_names[s->family], s->R1, s->R2, s->t, s->D, s->D2, err.message);
+    return st == LP_OK ? lens : NULL;
+}
+
+static const char *const builtin_names[] = {"N-BK7", "N-SF11", "F2",  "N-BAK4",
+                                            "N-SF6", "FUSED-SILICA", "CAF2"};
+
+/* A random glass: a catalog glass (absorbing) or a constant 1.3..2.0. */
+static inline void random_glass(lp_glass *g)
+{
+    if (sm64() & 1) {
+        const char *name = builtin_names[sm64() % (sizeof builtin_names / sizeof builtin_names[0])];
+        lp_error err;
+        lp_status st = lp_glass_builtin(name, g, &err);
+        CHECK(st == LP_OK, "lp_glass_builtin(\"%s\"): %s", name, err.message);
+        if (st == LP_OK)
+            return;
+    }
+    lp_glass_init_constant(g, urange(1.3, 2.0));
+}
+
+static inline void random_medium(lp_glass *g)
+{
+    lp_glass_init_constant(g, (sm64() & 1) ? 1.0 : urange(1.0, 1.4));
+}
+
+/* A random point on (or near) the lens surface, local frame. */
+static inline lv3 random_surface_point(const ref_lens *L, int which)
+{
+    long double phi = urange(0, 2 * M_PI);
+    if (which == 2 && L->rim) {
+        long double u = urand();
+        long double z = L->zf + u * (L->zb - L->zf), r = L->a1 + u * (L->a2 - L->a1);
+        return L3(r * cosl(phi), r * sinl(phi), z);
+    }
+    int back = which == 1;
+    long double a = back ? L->a2 : L->a1, r = sqrtl(urand()) * a;
+    long double z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
+    return L3(r * cosl(phi), r * sinl(phi), z);
+}
+static inline lv3 lcross(lv3 a, lv3 b)
+{
+    return L3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline lv3 lreflect(lv3 d, lv3 n) { return ladd(d, lscale(n, -2 * ldot(d, n))); }
+
+/* Snell: d hits a surface with (either-sided) normal n from index n1 into
+ * n2; 0 under TIR. */
+static inline int lrefract(lv3 d, lv3 n, long double n1, long double n2, lv3 *out)
+{
+    lv3 m = ldot(d, n) < 0 ? n : lscale(n, -1); /* toward the incident side */
+    long double ci = -ldot(d, m), eta = n1 / n2;
+    long double st2 = eta * eta * (1 - ci) * (1 + ci);
+    if (st2 >= 1)
+        return 0;
+    long double ct = sqrtl(1 - st2);
+    *out = lnorm(ladd(lscale(d, eta), lscale(m, eta * ci - ct)));
+    return 1;
+}
+
+#define MAXN 24
+typedef struct {
+    int n;                                   /* cap nodes 1..n */
+    lv3 p[MAXN + 2], nrm[MAXN + 2], din[MAXN + 2], drefl[MAXN + 2], dtran[MAXN + 2];
+    int surf[MAXN + 2], tir[MAXN + 2], good[MAXN + 2];
+    long double seg[MAXN + 2];               /* internal length node k-1 -> k */
+    long double cosi[MAXN + 2];
+    int rim_depth;                           /* node index of the rim, 0 none */
+    lv3 rim_p;                               /* where the chain meets the rim */
+    long double rim_cos;                     /* |cos| of incidence on the rim */
+    int leak;
+} chain;
+
+static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O, lv3 d, chain *c)
+{
+    memset(c, 0, sizeof *c);
+    ref_hit h = ref_intersect(L, O, d, 0.0L);
+    if (h.surf < 0)
+        return;
+    if (h.surf == LP_SURFACE_RIM) {
+        c->rim_depth = 1;
+        c->rim_p = h.p;
+        c->rim_cos = fabsl(ldot(d, h.n));
+        return;
+    }
+    lv3 dir = d;
+    long double n1 = nm, n2 = ng;
+    long double edge_m = 1e-6L * L->size;
+    for (int k = 1; k <= MAXN; k++) {
+        c->n = k;
+        c->p[k] = h.p;
+        c->nrm[k] = h.n;
+        c->surf[k] = h.surf;
+        c->din[k] = dir;
+        long double ci = fabsl(ldot(dir, h.n));
+        c->cosi[k] = ci;
+        c->drefl[k] = lreflect(dir, h.n);
+        c->tir[k] = !lrefract(dir, h.n, n1, n2, &c->dtran[k]);
+        /* conditioning: away from the cap's edge circle, not grazing, not
+         * near the critical angle */
+        long double a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
+        long double r = sqrtl(h.p.x * h.p.x + h.p.y * h.p.y);
+        long double x = (n1 / n2) * sqrtl((1 - ci) * (1 + ci)); /* sin of refraction */
+        int good = r < a - edge_m && ci > 0.02L && fabsl(x - 1) > 1e-3L;
+        if (!c->tir[k])
+            good = good && sqrtl((1 - x) * (1 + x)) > 0.02L;
+        c->good[k] = good;
+        lv3 next;
+        if (k == 1) {
+            if (c->tir[1])
+                return;
+            next = c->dtran[1];
+            n1 = ng;
+            n2 = nm;
+        } else {
+            next = c->drefl[k];
+        }
+        h = ref_intersect(L, h.p, next, 1e-9L * L->size);
+        if (h.surf < 0) {
+            c->leak = 1;
+            return;
+        }
+        if (h.surf == LP_SURFACE_RIM) {
+            c->rim_depth = k + 1;
+            c->rim_p = h.p;
+            c->rim_cos = fabsl(ldot(next, h.n));
+            return;
+        }
+        c->seg[k + 1] = h.s;
+        dir = next;
+    }
+}
+
+
+/* ------------------------------------------------------------------ */
+
+static char ctx[256];
+static const uint64_t SEED = 0x7171d0e5ULL;
+
+static lp_lens *lens_n(double R1, double R2, double t, double D, double D2, double n, const frame *f)
+{
+    rshape s = {R1, R2, t, D, D2, 0};
+    lp_glass g;
+    lp_glass_init_constant(&g, n);
+    return make_lens_g(&s, &g, NULL, f);
+}
+
+static void ray_init(lp_ray *in, lp_vec3 o, lp_vec3 d, double I)
+{
+    memset(in, 0, sizeof *in);
+    in->origin = o;
+    in->dir = vnorm(d);
+    in->lambda_nm = urange(380, 780);
+    in->intensity = I;
+    lp_vec3 vp;
+    do {
+        vp = rand_unit();
+    } while (vlen(vcross(vp, in->dir)) < 0.1);
+    in->vp = vp;
+    in->ch = 42;
+}
+
+static void check_balance(const lp_result *r, const char *what)
+{
+    double sum = r->out + r->skipped + r->absorbed_glass + r->absorbed_rim + r->truncated;
+    CHECK(isfinite(sum) && isfinite(r->in), "%s: bookkeeping not finite", what);
+    if (r->in > 0)
+        CHECK_REL(sum, r->in, 1e-12, "%s: in = out + skipped + glass + rim + truncated", what);
+    else
+        CHECK(sum == 0 && r->count == 0, "%s: nothing received but sum %g", what, sum);
+    double out = 0;
+    for (size_t i = 0; i < r->count; i++) {
+        const lp_ray *o = &r->rays[i].ray;
+        CHECK(vfinite(o->origin) && vfinite(o->dir) && vfinite(o->vp) && isfinite(o->intensity) &&
+                  isfinite(o->op) && isfinite(o->phase) && o->intensity >= 0,
+              "%s: output ray %zu not finite / negative", what, i);
+        out += o->intensity;
+    }
+    if (r->count)
+        CHECK_REL(out, r->out, 1e-12, "%s: out = sum of the output rays", what);
+}
+
+/* outward normal of the rim (cylinder or cone) at a local point */
+static lv3 rim_normal(const ref_lens *L, lv3 p)
+{
+    long double r = L->a1 + L->k * (p.z - L->zf);
+    return lnorm(L3(p.x, p.y, -r * L->k));
+}
+
+/* 1. rays from outside onto the rim: no output, all absorbed at the rim */
+static void test_rim_from_outside(void)
+{
+    const struct { double R1, R2, t, D, D2; } shapes[] = {
+        {50, -50, 8, 25, 0},   {25.8, INFINITY, 5.3, 25.4, 0}, {-40, 40, 2, 25, 0},
+        {30, 60, 5, 25, 0},    {0, INFINITY, 3, 20, 0},        {50, -50, 8, 30, 20},
+        {50, -50, 8, 20, 30},
+    };
+    for (size_t si = 0; si < sizeof shapes / sizeof shapes[0]; si++) {
+        frame f = si % 2 ? frame_make(V(urange(-20, 20), urange(-20, 20), urange(-20, 20)), rand_unit())
+                         : frame_identity();
+        ref_lens L;
+        ref_init(&L, shapes[si].R1, shapes[si].R2, shapes[si].t, shapes[si].D, shapes[si].D2);
+        lp_lens *lens = lens_n(shapes[si].R1, shapes[si].R2, shapes[si].t, shapes[si].D, shapes[si].D2,
+                               1.5, &f);
+        if (!lens)
+            continue;
+        CHECK(L.rim, "shape %zu has a rim", si);
+        lp_result res;
+        lp_result_init(&res);
+        int n_done = 0;
+        for (int k = 0; k < 200; k++) {
+            long double u = urange(0.02, 0.98), phi = urange(0, 2 * M_PI);
+            long double z = L.zf + u * (L.zb - L.zf), r = L.a1 + u * (L.a2 - L.a1);
+            lv3 P = L3(r * cosl(phi), r * sinl(phi), z);
+            lv3 n = rim_normal(&L, P);
+            lv3 d;
+            do {
+                d = lfrom(rand_unit());
+            } while (ldot(d, n) > -0.1L);
+            lv3 O = lsub(P, lscale(d, 3.0L * L.size));
+            ref_hit h = ref_intersect(&L, O, d, 0.0L);
+            if (h.surf != LP_SURFACE_RIM || llen(lsub(h.p, P)) > 1e-9L * L.size)
+                continue; /* a concave cap's lip is in the way */
+            snprintf(ctx, sizeof ctx, "[rim from outside: shape %zu ray %d]", si, k);
+            lp_vec3 Ow = lto(fw_point(&f, O)), dw = lto(fw_dir(&f, d));
+            lp_hit hit;
+            int got = lp_lens_intersect(lens, Ow, dw, 0.0, INFINITY, &hit);
+            CHECK(got && hit.surface == LP_SURFACE_RIM, "%s: intersect surface %d, want rim", ctx,
+                  got ? hit.surface : -9);
+            if (got) {
+                CHECK_ABS((double)llen(lsub(fl_point(&f, hit.point), P)) / L.size, 0.0, 1e-12,
+                          "%s: rim hit point", ctx);
+                CHECK_ABS((double)llen(lsub(fl_dir(&f, hit.normal), n)), 0.0, 1e-10,
+                          "%s: rim normal (cylinder/cone, outward)", ctx);
+            }
+            lp_ray in;
+            ray_init(&in, Ow, dw, urange(0.5, 2));
+            lp_trace_args args;
+            lp_trace_args_init(&args);
+            args.mode = (lp_mode)(k % 3);
+            args.max_depth = 1 + k % 10;
+            lp_status st = lp_trace_forward(lens, &in, &args, &res, NULL);
+            CHECK(st == LP_OK, "%s: status %d", ctx, (int)st);
+            CHECK(res.count == 0, "%s: %zu output rays from a rim hit", ctx, res.count);
+            CHECK_REL(res.in, in.intensity, 1e-15, "%s: in", ctx);
+            CHECK_REL(res.absorbed_rim, res.in, 1e-15, "%s: absorbed_rim = in", ctx);
+            check_balance(&res, ctx);
+            /* backward: a view ray on the rim has rim depth 1 and no queries */
+            lp_backward *bw = NULL;
+            lp_backward_create(&bw, NULL);
+            if (bw) {
+                st = lp_backward_build(bw, lens, Ow, dw, 550, &args, NULL);
+                CHECK(st == LP_OK, "%s: backward build", ctx);
+                CHECK(lp_backward_rim_depth(bw) == 1, "%s: rim depth %d, want 1", ctx,
+                      lp_backward_rim_depth(bw));
+                CHECK(lp_backward_query_count(bw) == 0, "%s: %zu queries", ctx,
+                      lp_backward_query_count(bw));
+                lp_backward_destroy(bw);
+            }
+            n_done++;
+        }
+        CHECK(n_done > 50, "shape %zu: %d rim rays tested", si, n_done);
+        lp_result_release(&res);
+        lp_lens_destroy(lens);
+    }
+}
+
+/* 2. the conical rim: containment near the cone */
+static void test_cone_contains(void)
+{
+    ref_lens L;
+    ref_init(&L, 50, -50, 8, 30, 20);
+    frame f = frame_identity();
+    lp_lens *lens = lens_n(50, -50, 8, 30, 20, 1.5, &f);
+    if (!lens)
+        return;
+    /* closed form: zf = 50 - sqrt(2500 - 225), zb = 8 - (50 - sqrt(2500 - 100)) */
+    CHECK_ABS((double)L.zf, 50 - sqrt(2275.0), 1e-13, "cone lens: front edge z");
+    CHECK_ABS((double)L.zb, 8 - 50 + sqrt(2400.0), 1e-13, "cone lens: back edge z");
+    for (int k = 0; k < 300; k++) {
+        long double u = urange(0.02, 0.98), phi = urange(0, 2 * M_PI);
+        long double z = L.zf + u * (L.zb - L.zf), r = L.a1 + u * (L.a2 - L.a1);
+        lv3 P = L3(r * cosl(phi), r * sinl(phi), z);
+        lv3 n = rim_normal(&L, P);
+        for (int j = 1; j <= 3; j++) {
+            long double e = powl(10, -2 * j); /* 1e-2, 1e-4, 1e-6 mm */
+            CHECK(lp_lens_contains(lens, lto(ladd(P, lscale(n, -e)))), "cone: %Lg inside is inside", e);
+            CHECK(!lp_lens_contains(lens, lto(ladd(P, lscale(n, e)))), "cone: %Lg outside is outside", e);
+        }
+        /* points inside the old cylinder r < 15 but outside the cone */
+        long double rc = r + 0.5L * (L.a1 - r);
+        if (rc > r + 0.05L)
+            CHECK(!lp_lens_contains(lens, lto(L3(rc * cosl(phi), rc * sinl(phi), z))),
+                  "cone: r=%Lg at z=%Lg (cone radius %Lg) is outside", rc, z, r);
+    }
+    lp_lens_destroy(lens);
+}
+
+/* 3. entering the front cap near the edge, refracted into the rim:
+ * absorbed at depth 2 */
+static void test_refracted_into_rim(void)
+{
+    const double n = 1.5;
+    ref_lens L;
+    ref_init(&L, 50, -50, 8, 30, 20);
+    frame f = frame_make(V(3, -4, 12), V(0.2, 0.1, 1));
+    lp_lens *lens = lens_n(50, -50, 8, 30, 20, n, &f);
+    if (!lens)
+        return;
+    lp_result res;
+    lp_result_init(&res);
+    lp_backward *bw = NULL;
+    lp_backward_create(&bw, NULL);
+    int found = 0;
+    for (int k = 0; k < 4000 && found < 60; k++) {
+        long double r = urange(12.5, 14.8), phi = urange(0, 2 * M_PI);
+        lv3 P = L3(r * cosl(phi), r * sinl(phi), rsag(L.c1, r));
+        lv3 nP = lnorm(L3(L.c1 * P.x, L.c1 * P.y, L.c1 * P.z - 1)); /* outward front normal */
+        /* incoming from the front, tilted outward */
+        lv3 d = lnorm(L3(urange(0, 1.2) * cosl(phi), urange(0, 1.2) * sinl(phi) + urange(-0.2, 0.2), 1));
+        long double ci = -ldot(d, nP);
+        if (ci < 0.1L)
+            continue;
+        lv3 dt;
+        if (!lrefract(d, nP, 1.0L, n, &dt))
+            continue;
+        lv3 O = lsub(P, lscale(d, 3.0L * L.size));
+        ref_hit h0 = ref_intersect(&L, O, d, 0.0L);
+        if (h0.surf != LP_SURFACE_FRONT || llen(lsub(h0.p, P)) > 1e-9L * L.size)
+            continue;
+        ref_hit h = ref_intersect(&L, P, dt, 1e-9L * L.size);
+        if (h.surf != LP_SURFACE_RIM || h.p.z - L.zf < 0.05L || L.zb - h.p.z < 0.05L)
+            continue;
+        found++;
+        snprintf(ctx, sizeof ctx, "[refracted into the rim, case %d]", found);
+        lp_ray in;
+        ray_init(&in, lto(fw_point(&f, O)), lto(fw_dir(&f, d)), urange(0.5, 2));
+        lp_trace_args args;
+        lp_trace_args_init(&args);
+        args.mode = (lp_mode)(found % 3);
+        args.max_depth = 2 + found % 8;
+        lp_status st = lp_trace_forward(lens, &in, &args, &res, NULL);
+        CHECK(st == LP_OK, "%s: status", ctx);
+        check_balance(&res, ctx);
+        /* the external reflectance at the entry, computed here */
+        long double Rs, Rp;
+        {
+            long double ct = sqrtl(1 - (1 - ci * ci) / (n * n));
+            long double rs = (ci - n * ct) / (ci + n * ct), rp = (n * ci - ct) / (n * ci + ct);
+            Rs = rs * rs;
+            Rp = rp * rp;
+            long double R;
+            if (args.mode == LP_MODE_POLARIZED) {
+                lv3 v = fl_dir(&f, vnorm(in.vp));
+                v = lnorm(lsub(v, lscale(d, ldot(v, d))));
+                lv3 sx = lnorm(lcross(d, nP));
+                long double as2 = ldot(v, sx) * ldot(v, sx);
+                R = Rs * as2 + Rp * (1 - as2);
+            } else if (args.mode == LP_MODE_FRESNEL) {
+                R = (Rs + Rp) / 2;
+            } else {
+                long double R0 = powl((1 - n) / (1 + n), 2);
+                R = R0 + (1 - R0) * powl(1 - ci, 5);
+            }
+            CHECK_REL(res.absorbed_rim, (double)((1 - R) * in.intensity), 1e-10,
+                      "%s: absorbed_rim = the refracted power (1 - R) I", ctx);
+            CHECK_REL(res.out, (double)(R * in.intensity), 1e-10, "%s: out = the external reflection", ctx);
+        }
+        CHECK(res.absorbed_rim > 0, "%s: absorbed_rim > 0", ctx);
+        for (size_t i = 0; i < res.count; i++)
+            CHECK(res.rays[i].depth == 1, "%s: output at depth %d (only the reflection expected)", ctx,
+                  res.rays[i].depth);
+        CHECK_ABS(res.truncated, 0.0, 0.0, "%s: nothing truncated", ctx);
+        if (bw) {
+            st = lp_backward_build(bw, lens, in.origin, in.dir, in.lambda_nm, &args, NULL);
+            CHECK(st == LP_OK, "%s: backward build", ctx);
+            CHECK(lp_backward_rim_depth(bw) == 2, "%s: rim depth %d, want 2", ctx,
+                  lp_backward_rim_depth(bw));
+            size_t nq = lp_backward_query_count(bw);
+            const lp_query *q = lp_backward_queries(bw);
+            CHECK(nq == 1 && q[0].depth == 1, "%s: %zu queries (want only the depth-1 reflection)", ctx,
+                  nq);
+        }
+    }
+    CHECK(found >= 30, "found %d rays refracted into the rim", found);
+    lp_backward_destroy(bw);
+    lp_result_release(&res);
+    lp_lens_destroy(lens);
+}
+
+/* 4. lp_backward_rim_depth against the reference chain on random lenses */
+static void test_rim_depth_random(void)
+{
+    lp_backward *bw = NULL;
+    CHECK(lp_backward_create(&bw, NULL) == LP_OK, "backward create");
+    if (!bw)
+        return;
+    lp_result res;
+    lp_result_init(&res);
+    long hist[MAXN + 2] = {0};
+    long compared = 0, skipped = 0;
+    for (int li = 0; li < 300; li++) {
+        rng_state = SEED + (uint64_t)li * 0x9E3779B97F4A7C15ULL;
+        rshape s;
+        random_shape(&s);
+        long double ng = urange(1.3, 2.0), nm = (sm64() & 1) ? 1.0 : urange(1.0, 1.25);
+        lp_glass glass, medium;
+        lp_glass_init_constant(&glass, (double)ng);
+        lp_glass_init_constant(&medium, (double)nm);
+        frame f = frame_make(V(urange(-20, 20), urange(-20, 20), urange(-20, 20)), rand_unit());
+        ref_lens L;
+        ref_init(&L, s.R1, s.R2, s.t, s.D, s.D2);
+        lp_lens *lens = make_lens_g(&s, &glass, &medium, &f);
+        if (!lens)
+            continue;
+        for (int vi = 0; vi < 20; vi++) {
+            int which = (int)(sm64() % 5);
+            lv3 T = random_surface_point(&L, which < 2 ? 0 : (which < 4 ? 1 : 2));
+            lv3 d = lfrom(rand_unit());
+            lv3 O = lsub(T, lscale(d, 2.0L * L.size));
+            lp_vec3 Ow = lto(fw_point(&f, O)), dw = lto(fw_dir(&f, d));
+            O = fl_point(&f, Ow);
+            d = lnorm(fl_dir(&f, dw));
+            lp_trace_args args;
+            lp_trace_args_init(&args);
+            args.max_depth = 1 + (int)(sm64() % 12);
+            args.mode = (lp_mode)(sm64() % 3);
+            chain c;
+            build_chain(&L, ng, nm, O, d, &c);
+            /* expected rim depth, and whether the chain is unambiguous */
+            int want = c.rim_depth;
+            int good = !c.leak;
+            int last = c.rim_depth ? c.rim_depth - 1 : c.n;
+            if (last > args.max_depth)
+                last = args.max_depth;
+            for (int k = 1; k <= last; k++)
+                good = good && c.good[k];
+            if (c.rim_depth && c.rim_depth <= args.max_depth) {
+                long double m = 1e-6L * L.size;
+                good = good && c.rim_p.z - L.zf > m && L.zb - c.rim_p.z > m && c.rim_cos > 0.02L;
+            }
+            if (c.rim_depth == args.max_depth + 1)
+                good = 0; /* the rim just past the depth limit: not specified */
+            if (!c.rim_depth && c.n <= args.max_depth)
+                good = 0; /* chain ended (TIR at entry / miss): nothing to compare */
+            if (c.n == 0 && c.rim_depth == 0)
+                good = 0;
+            if (want > args.max_depth)
+                want = 0;
+            if (!good) {
+                skipped++;
+                continue;
+            }
+            snprintf(ctx, sizeof ctx, "[rim depth: seed %#llx lens %d (%s) view %d, max_depth %d]",
+                     (unsigned long long)SEED, li, family_names[s.family], vi, args.max_depth);
+            lp_status st = lp_backward_build(bw, lens, Ow, dw, 550, &args, NULL);
+            CHECK(st == LP_OK, "%s: build", ctx);
+            CHECK(lp_backward_rim_depth(bw) == want, "%s: rim depth %d, want %d", ctx,
+                  lp_backward_rim_depth(bw), want);
+            /* the same ray as light: rim absorption iff the chain meets the rim */
+            lp_ray in;
+            ray_init(&in, Ow, dw, 1.0);
+            in.lambda_nm = 550;
+            st = lp_trace_forward(lens, &in, &args, &res, NULL);
+            CHECK(st == LP_OK, "%s: forward", ctx);
+            check_balance(&res, ctx);
+            if (want)
+                CHECK(res.absorbed_rim > 0, "%s: forward absorbed nothing at the rim", ctx);
+            else if (!(res.warnings & LP_WARN_LEAK))
+                CHECK(res.absorbed_rim == 0, "%s: forward absorbed %g at the rim, chain does not meet it",
+                      ctx, res.absorbed_rim);
+            hist[want]++;
+            compared++;
+        }
+        lp_lens_destroy(lens);
+    }
+    printf("test_rim: rim depth compared on %ld view rays (%ld skipped as ambiguous); by depth:", compared,
+           skipped);
+    for (int k = 0; k <= 12; k++)
+        printf(" %d:%ld", k, hist[k]);
+    printf("\n");
+    CHECK(compared > 3000 && hist[1] > 100 && hist[2] > 100 && hist[3] > 20,
+          "rim depths sampled broadly");
+    lp_result_release(&res);
+    lp_backward_destroy(bw);
+}
+
+/* 5. rays through the exact cap/rim edge circle */
+static void test_edge_circle(void)
+{
+    const struct { double R1, R2, t, D, D2; } shapes[] = {
+        {50, -50, 8, 25, 0}, {50, -50, 8, 30, 20}, {-40, 40, 2, 25, 0}, {5, -5, 2, 6, 0},
+        {25.8, INFINITY, 5.3, 25.4, 0}, {0, INFINITY, 3, 20, 0},
+    };
+    lp_result res;
+    lp_result_init(&res);
+    for (size_t si = 0; si < sizeof shapes / sizeof shapes[0]; si++) {
+        frame f = si % 2 ? frame_make(V(1, 2, 3), rand_unit()) : frame_identity();
+        ref_lens L;
+        ref_init(&L, shapes[si].R1, shapes[si].R2, shapes[si].t, shapes[si].D, shapes[si].D2);
+        lp_lens *lens = lens_n(shapes[si].R1, shapes[si].R2, shapes[si].t, shapes[si].D, shapes[si].D2,
+                               1.5, &f);
+        if (!lens)
+            continue;
+        for (int k = 0; k < 400; k++) {
+            int back = k & 1;
+            double phi = (k % 8 == 0) ? 0.0 : urange(0, 2 * M_PI);
+            long double a = back ? L.a2 : L.a1;
+            lv3 P = L3(a * cosl(phi), a * sinl(phi), back ? L.zb : L.zf);
+            if (k % 8 == 0)
+                P.y = 0; /* exactly on the x axis */
+            lv3 d = lfrom(rand_unit());
+            lv3 O = lsub(P, lscale(d, 3.0L * L.size));
+            lp_vec3 Ow = lto(fw_point(&f, O)), dw = lto(fw_dir(&f, d));
+            snprintf(ctx, sizeof ctx, "[edge circle: shape %zu ray %d]", si, k);
+            lp_hit h;
+            memset(&h, 0, sizeof h);
+            if (lp_lens_intersect(lens, Ow, dw, 0.0, INFINITY, &h))
+                CHECK(isfinite(h.t) && vfinite(h.point) && vfinite(h.normal) &&
+                          fabs(vlen(h.normal) - 1) < 1e-9,
+                      "%s: non-finite hit", ctx);
+            lp_ray in;
+            ray_init(&in, Ow, dw, 1.0);
+            lp_trace_args args;
+            lp_trace_args_init(&args);
+            args.mode = (lp_mode)(k % 3);
+            args.max_depth = 1 + k % 15;
+            lp_status st = lp_trace_forward(lens, &in, &args, &res, NULL);
+            CHECK(st == LP_OK, "%s: status %d", ctx, (int)st);
+            check_balance(&res, ctx);
+            for (size_t i = 0; i < res.count; i++)
+                CHECK(res.rays[i].depth >= 1 && res.rays[i].depth <= args.max_depth, "%s: depth %d",
+                      ctx, res.rays[i].depth);
+            lp_backward *bw = NULL;
+            lp_backward_create(&bw, NULL);
+            if (bw) {
+                st = lp_backward_build(bw, lens, Ow, dw, 550, &args, NULL);
+                CHECK(st == LP_OK, "%s: backward build at the edge", ctx);
+                size_t nq = lp_backward_query_count(bw);
+                const lp_query *q = lp_backward_queries(bw);
+                for (size_t i = 0; i < nq; i++)
+                    CHECK(vfinite(q[i].origin) && vfinite(q[i].dir) && isfinite(q[i].op) &&
+                              isfinite(q[i].bound) && q[i].bound >= 0,
+                          "%s: query %zu not finite", ctx, i);
+                lp_backward_destroy(bw);
+            }
+        }
+        lp_lens_destroy(lens);
+    }
+    lp_result_release(&res);
+}
+
+int main(void)
+{
+    rng_state = SEED;
+    test_rim_from_outside();
+    test_cone_contains();
+    test_refracted_into_rim();
+    test_rim_depth_random();
+    test_edge_circle();
+    return check_finish("test_rim");
+}
