@@ -29,8 +29,17 @@ static const char *const LENSTRACE = LP_BIN_DIR "/lenstrace";
 /* The lens of the contract's example: plano-convex, N-BK7. */
 static const char *const LENS = "R1=25.8,R2=inf,t=5.3,D=25.4,glass=N-BK7";
 static const double T_MM = 5.3;
-/* N-BK7 catalog n_d (Schott) at the helium d line, 587.5618 nm. */
+/* N-BK7 catalog n_d (Schott) at the helium d line, 587.5618 nm in air.
+ * The contract's lambda is a vacuum wavelength: the d line in vacuum is
+ * 587.5618 * n_air = 587.7247 nm (Edlen 1966 standard air, below). */
 static const double N_D = 1.51680;
+
+/* Edlen (1966) standard air at a vacuum wavelength (nm). */
+static double air_index(double vac_nm)
+{
+    double s2 = (1000.0 / vac_nm) * (1000.0 / vac_nm);
+    return 1.0 + 1e-8 * (8342.13 + 2406030.0 / (130.0 - s2) + 15997.0 / (38.9 - s2));
+}
 
 /* ------------------------------------------------------------------ */
 /* Running the program                                                 */
@@ -555,7 +564,7 @@ static double fresnel_normal(double n1, double n2)
 }
 
 static const char *const AXIAL =
-    "o=0,0,-10 d=0,0,1 lambda=587.5618 vp=1,0,0 I=1 ch=7";
+    "o=0,0,-10 d=0,0,1 lambda=587.7247 vp=1,0,0 I=1 ch=7";
 
 /* Forward, axial, polarized: physics and shape.  Keeps the depth-2
  * transmit intensity for the backward (reciprocity) check. */
@@ -591,7 +600,7 @@ static double test_forward_axial(void)
     for (size_t i = 0; i < o.n; i++) {
         CHECK(o.rays[i].depth <= 5, "default depth 5: line %zu depth %d", i,
               o.rays[i].depth);
-        CHECK(o.rays[i].lambda == 587.5618, "lambda copied exactly: %.17g",
+        CHECK(o.rays[i].lambda == 587.7247, "lambda copied exactly: %.17g",
               o.rays[i].lambda);
         CHECK(o.rays[i].ch == 7.0, "ch copied: %g", o.rays[i].ch);
         CHECK(o.rays[i].half == -1, "no half key for a polarized ray");
@@ -606,7 +615,8 @@ static double test_forward_axial(void)
         CHECK_ABS(r2->o[0], 0.0, 1e-9, "depth-2 transmit o.x");
         CHECK_ABS(r2->o[1], 0.0, 1e-9, "depth-2 transmit o.y");
         CHECK_ABS(r2->o[2], T_MM, 1e-9, "depth-2 transmit o.z = t");
-        CHECK_REL(r2->op, N_D * T_MM, 1e-5, "depth-2 transmit op = n*t");
+        CHECK_REL(r2->op, air_index(587.7247) * N_D * T_MM, 1e-5,
+                  "depth-2 transmit op = n_air*n*t (absolute optical path)");
         /* Two refractions keep the phase and the field direction. */
         CHECK(r2->kphi == 0, "depth-2 transmit kphi 0, got %d", r2->kphi);
         CHECK_ABS(r2->phase, 0.0, 1e-12, "depth-2 transmit phase");
@@ -626,7 +636,7 @@ static double test_forward_axial(void)
     {
         /* The same run with --opt=VALUE gives the same bytes. */
         proc q = run("--lens=R1=25.8,R2=inf,t=5.3,D=25.4,glass=N-BK7",
-                     "--ray=o=0,0,-10 d=0,0,1 lambda=587.5618 vp=1,0,0 I=1 ch=7",
+                     "--ray=o=0,0,-10 d=0,0,1 lambda=587.7247 vp=1,0,0 I=1 ch=7",
                      "--depth=5", "--mode=polarized", "--medium=1",
                      (const char *)NULL);
         expect_success(&q, "--opt=VALUE form");
@@ -665,7 +675,7 @@ static void test_unpolarized(void)
     static output o;
     const double R = fresnel_normal(1.0, N_D);
     proc p = run("--lens", LENS, "--ray",
-                 "o=0,0,-10 d=0,0,1 lambda=587.5618 vp=unpolarized ch=2",
+                 "o=0,0,-10 d=0,0,1 lambda=587.7247 vp=unpolarized ch=2",
                  (const char *)NULL);
     size_t n0 = 0, n1 = 0;
     int order_ok = 1, seen1 = 0;
@@ -712,7 +722,7 @@ static void test_unpolarized(void)
     {
         /* vp omitted: unpolarized by default. */
         proc q = run("--lens", LENS, "--ray",
-                     "o=0,0,-10 d=0,0,1 lambda=587.5618 ch=2",
+                     "o=0,0,-10 d=0,0,1 lambda=587.7247 ch=2",
                      (const char *)NULL);
         expect_success(&q, "vp omitted");
         CHECK(strcmp(q.out, p.out) == 0, "vp omitted = vp=unpolarized");
@@ -727,7 +737,7 @@ static void test_backward(double forward_i2)
     static output o;
     const double R = fresnel_normal(1.0, N_D);
     proc p = run("--lens", LENS, "--ray",
-                 "o=0,0,-10 d=0,0,1 lambda=587.5618 vp=1,0,0 I=1 ch=3",
+                 "o=0,0,-10 d=0,0,1 lambda=587.7247 vp=1,0,0 I=1 ch=3",
                  "--backward", (const char *)NULL);
     const rayline *r1, *r2;
 
@@ -758,7 +768,8 @@ static void test_backward(double forward_i2)
         double qd[3];
         CHECK(jvec(r2->text, "query_d", qd) && fabs(qd[2] - 1.0) < 1e-12,
               "backward: the depth-2 query leaves along +z");
-        CHECK_REL(r2->op, N_D * T_MM, 1e-5, "backward depth-2 op = n*t");
+        CHECK_REL(r2->op, air_index(587.7247) * N_D * T_MM, 1e-5,
+                  "backward depth-2 op = n_air*n*t");
         if (isfinite(forward_i2))
             CHECK_REL(r2->I, forward_i2, 1e-9,
                       "reciprocity: backward depth-2 I = forward depth-2 I");
@@ -823,7 +834,8 @@ static void test_modes_and_medium(void)
                       "medium 1.333, n 1.5: R");
         r2 = find_ray(&o, 2, "transmit", -1);
         if (r2)
-            CHECK_REL(r2->op, 1.5 * T_MM, 1e-12, "constant glass op = n*t");
+            CHECK_REL(r2->op, air_index(587.7247) * 1.5 * T_MM, 1e-12,
+                      "constant glass op = n_air*n*t");
         check_balance(&o, "medium");
         free(o.buf);
         proc_free(&p);

@@ -12,8 +12,14 @@
  *
  * CONVENTIONS (stated once, valid for the whole API)
  *
- *   Units        lengths in millimetres, vacuum wavelengths in nanometres,
+ *   Units        lengths in millimetres, wavelengths in nanometres,
  *                angles and phases in radians, absorption in 1/mm.
+ *   Wavelengths  are in standard air, and every index (glass, medium) is
+ *                relative to standard air, as glass makers' catalogs and
+ *                the CIE tables give them; the default medium n = 1 is
+ *                air.  In that frame Phi below is exact.  A vacuum
+ *                wavelength l0 is l0 / lp_air_index(l0) in air, and the
+ *                absolute optical path is lp_air_index(l0) * op.
  *   Lens frame   local axis +z, front vertex at the origin, back vertex at
  *                z = thickness.  The lens is placed in the world by the
  *                world position of its front vertex and the world
@@ -22,8 +28,6 @@
  *   Radii        optics sign convention: R > 0 means the centre of
  *                curvature lies at +z of the vertex.  A biconvex lens has
  *                radius1 > 0 and radius2 < 0.  0 or +-INFINITY is flat.
- *   Indices      catalog indices are relative to air, so the default
- *                surrounding medium is a constant n = 1 ("air").
  *   Polarization a ray is fully linearly polarized: its electric field is
  *                E = sqrt(I) * vp * exp(i*Phi) with the total phase
  *                      Phi = 2*pi*op/lambda - pi*kphi + phase
@@ -114,6 +118,10 @@ typedef struct lp_vec3 {
     double x, y, z;
 } lp_vec3;
 
+/* Refractive index of standard dry air (Edlen 1966: 15 degC, 101325 Pa)
+ * at a vacuum wavelength, 160 nm and up; NaN outside. */
+LP_API double lp_air_index(double lambda_vacuum_nm);
+
 /* ------------------------------------------------------------------ */
 /* Glass                                                               */
 /* ------------------------------------------------------------------ */
@@ -169,7 +177,8 @@ LP_API void lp_glass_init_sellmeier(lp_glass *glass, const char *name,
  * range is unbounded), a valid transmittance table. */
 LP_API lp_status lp_glass_check(const lp_glass *glass, lp_error *err);
 
-/* Refractive index at a vacuum wavelength; NaN for an unsupported formula
+/* Refractive index relative to air at a wavelength in air (see the
+ * conventions above); NaN for an unsupported formula
  * or a wavelength <= 0.  No range check: see lp_glass_covers. */
 LP_API double lp_glass_index(const lp_glass *glass, double lambda_nm);
 
@@ -287,7 +296,7 @@ LP_API int lp_lens_contains(const lp_lens *lens, lp_vec3 point);
 typedef struct lp_ray {
     lp_vec3 origin;
     lp_vec3 dir;        /* unit */
-    double lambda_nm;   /* vacuum wavelength */
+    double lambda_nm;   /* wavelength in standard air */
     double intensity;   /* power carried, >= 0 */
     lp_vec3 vp;         /* unit field direction, perpendicular to dir */
     int kphi;           /* phase jumps by pi */

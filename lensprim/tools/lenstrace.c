@@ -45,7 +45,9 @@ static const char *const usage_text[] = {
 "                     \"o=0,3,-10 d=0,0,1 lambda=587.56 vp=1,0,0 I=1 ch=7\"\n"
 "                   o=x,y,z   origin                               required\n"
 "                   d=x,y,z   direction (normalized)               required\n"
-"                   lambda=NM vacuum wavelength (default 587.56)\n"
+"                   lambda=NM vacuum wavelength (default 587.56); glass\n"
+"                             data are for air, so the ray is traced at\n"
+"                             lambda/n_air (standard air, Edlen 1966)\n"
 "                   vp=x,y,z  field direction, made perpendicular to d,\n"
 "                             or vp=unpolarized (the default)\n"
 "                   I=..      intensity (default 1)\n"
@@ -54,7 +56,8 @@ static const char *const usage_text[] = {
 "  --mode M         polarized (Fresnel on s and p with vectors and phases,\n"
 "                   the default), fresnel ((Rs+Rp)/2 per interface) or\n"
 "                   schlick (Schlick's approximation)\n"
-"  --medium N       constant index of the surrounding medium (default 1)\n"
+"  --medium N       index of the surrounding medium relative to air\n"
+"                   (default 1: air)\n"
 "  --catalog FILE   load more glasses from a Zemax AGF file (repeatable;\n"
 "                   a later glass of the same name replaces an earlier one)\n"
 "  --backward       trace from the eye (see BACKWARD below)\n"
@@ -70,7 +73,8 @@ static const char *const usage_text[] = {
 "  kind     reflect (leaves on the side the light came from) or transmit\n"
 "  vp       unit field direction; the field is sqrt(I)*vp*exp(i*Phi) with\n"
 "           Phi = 2*pi*op/lambda - pi*kphi + phase\n"
-"  op       optical path inside the lens (sum of n*s), mm\n"
+"  op       optical path inside the lens, mm: n_air * sum of n*s with the\n"
+"           air-relative glass index n (the absolute optical path)\n"
 "  phase    extra phase beyond 2*pi*op/lambda - pi*kphi (non-zero only\n"
 "           after total internal reflection)\n"
 "  surface  cap the ray leaves from (front or back); part 0, or 1 for the\n"
@@ -209,17 +213,17 @@ static const char *surface_name(int s)
 /* One ray line.  query: NULL for a forward trace.  half: -1 when the ray
  * is polarized (no "half" key). */
 static void put_ray(outbuf *b, const lp_out_ray *r, const lp_query *query,
-                    int half)
+                    int half, double lambda_vac, double n_air)
 {
     ob_printf(b, "{\"depth\":%d,\"kind\":\"%s\"", r->depth,
               r->kind == LP_KIND_REFLECT ? "reflect" : "transmit");
     ob_vec(b, "o", r->ray.origin);
     ob_vec(b, "d", r->ray.dir);
-    ob_num(b, "lambda", r->ray.lambda_nm);
+    ob_num(b, "lambda", lambda_vac);
     ob_num(b, "I", r->ray.intensity);
     ob_vec(b, "vp", r->ray.vp);
     ob_printf(b, ",\"kphi\":%d", r->ray.kphi);
-    ob_num(b, "op", r->ray.op);
+    ob_num(b, "op", r->ray.op * n_air);
     ob_num(b, "phase", r->ray.phase);
     ob_printf(b, ",\"ch\":%" PRIu64, r->ray.ch);
     if (query) {
@@ -306,6 +310,8 @@ typedef struct run {
     lp_trace_args targs;
     outbuf out;
     totals sum;
+    double n_air;      /* standard air at the vacuum wavelength given */
+    double lambda_air; /* the wavelength the library traces at */
     char msg[512];
 } run;
 
@@ -331,7 +337,7 @@ static int run_forward(run *r)
         memset(&in, 0, sizeof in);
         in.origin = ray->o;
         in.dir = ray->d;
-        in.lambda_nm = ray->lambda_nm;
+        in.lambda_nm = r->lambda_air;
         in.intensity = ray->intensity / halves;
         in.vp = ray->unpolarized ? half_vp(ray->d, h) : ray->vp;
         in.ch = ray->ch;
@@ -343,7 +349,8 @@ static int run_forward(run *r)
             break;
         }
         for (size_t i = 0; i < res.count; i++)
-            put_ray(&r->out, &res.rays[i], NULL, ray->unpolarized ? h : -1);
+            put_ray(&r->out, &res.rays[i], NULL, ray->unpolarized ? h : -1,
+                    ray->lambda_nm, r->n_air);
         add_totals(&r->sum, &res);
     }
     lp_result_release(&res);
@@ -369,7 +376,7 @@ static int run_backward(run *r)
     memset(&err, 0, sizeof err);
     st = lp_backward_create(&bw, &err);
     if (st == LP_OK)
-        st = lp_backward_build(bw, r->lens, ray->o, ray->d, ray->lambda_nm,
+        st = lp_backward_build(bw, r->lens, ray->o, ray->d, r->lambda_air,
                                &r->targs, &err);
     if (st != LP_OK) {
         snprintf(r->msg, sizeof r->msg, "%s", lib_message(&err, st));
@@ -387,7 +394,7 @@ static int run_backward(run *r)
             memset(&b, 0, sizeof b);
             b.origin = qs[q].origin;
             b.dir = back;
-            b.lambda_nm = ray->lambda_nm;
+            b.lambda_nm = r->lambda_air;
             b.intensity = ray->intensity / halves;
             b.ch = ray->ch;
             if (ray->unpolarized)
@@ -429,7 +436,7 @@ static int run_backward(run *r)
     if (ok) {
         for (size_t i = 0; i < res.count; i++)
             put_ray(&r->out, &res.rays[i], &qs[qidx[i]],
-                    ray->unpolarized ? half[i] : -1);
+                    ray->unpolarized ? half[i] : -1, ray->lambda_nm, r->n_air);
         add_totals(&r->sum, &res);
     }
     free(qidx);
@@ -584,7 +591,16 @@ int main(int argc, char **argv)
 
     memset(&r, 0, sizeof r);
     r.a = a;
-    if (!build_and_trace(&r)) {
+    /* The contract's wavelengths are in vacuum; the library works in
+     * standard air with air-relative indices (as glass catalogs do).  Trace
+     * at the air wavelength and report the absolute optical path, so that
+     * 2*pi*op/lambda stays exact with the vacuum lambda printed. */
+    r.n_air = lp_air_index(a->ray.lambda_nm);
+    r.lambda_air = a->ray.lambda_nm / r.n_air;
+    if (!isfinite(r.n_air)) {
+        say(NULL, "lambda must be a vacuum wavelength of at least 160 nm");
+        status = EXIT_BAD;
+    } else if (!build_and_trace(&r)) {
         say(NULL, r.msg);
         status = EXIT_BAD;
     } else {
