@@ -1,0 +1,285 @@
+/* args.c -- parsing of lensrender's options.  No printing, no allocation,
+ * no global mutable state: every message goes into the caller's
+ * rs_args.error. */
+#include "args.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char *fail(rs_args *args, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+static const char *fail(rs_args *args, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(args->error, sizeof args->error, fmt, ap);
+    va_end(ap);
+    return args->error;
+}
+
+void rs_args_init(rs_args *args)
+{
+    memset(args, 0, sizeof *args);
+    args->width = 320;
+    args->height = 240;
+    args->mode = RS_MODE_POLARIZED;
+    args->mode_auto = 0;
+    args->depth = 0;
+    args->wavelengths = 16;
+    args->threads = 0;
+    args->cutoff = -1.0;
+}
+
+const char *rs_mode_name(rs_mode mode)
+{
+    switch (mode) {
+    case RS_MODE_POLARIZED: return "polarized";
+    case RS_MODE_FRESNEL: return "fresnel";
+    case RS_MODE_SCHLICK: return "schlick";
+    case RS_MODE_RGB: return "rgb";
+    }
+    return "unknown";
+}
+
+static int is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' ||
+           c == '\f';
+}
+
+/* A whole string as an integer in [lo, hi].  1: ok; 0: not an integer;
+ * -1: out of range. */
+static int parse_int(const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    long v;
+    if (*s == '\0' || is_space(*s))
+        return 0;
+    errno = 0;
+    v = strtol(s, &end, 10);
+    if (end == s || *end != '\0')
+        return 0;
+    if (errno == ERANGE || v < lo || v > hi)
+        return -1;
+    *out = v;
+    return 1;
+}
+
+/* A whole string as a finite double.  1: ok; 0: not a finite number. */
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    double v;
+    if (*s == '\0' || is_space(*s))
+        return 0;
+    errno = 0;
+    v = strtod(s, &end);
+    if (end == s || *end != '\0' || !isfinite(v))
+        return 0;
+    *out = v;
+    return 1;
+}
+
+static const char *int_option(rs_args *args, const char *name, const char *val,
+                              long lo, long hi, int *out)
+{
+    long v;
+    int r = parse_int(val, lo, hi, &v);
+    if (r == 0)
+        return fail(args, "%s: '%s' is not a whole number", name, val);
+    if (r < 0)
+        return fail(args, "%s: %s is out of range (%ld..%ld)", name, val, lo, hi);
+    *out = (int)v;
+    return NULL;
+}
+
+/* The options that take a value. */
+enum {
+    OPT_OUT, OPT_WIDTH, OPT_HEIGHT, OPT_MODE, OPT_DEPTH, OPT_WAVELENGTHS,
+    OPT_THREADS, OPT_PFM, OPT_CUTOFF, OPT_COUNT
+};
+
+static const struct {
+    const char *name;
+    int id;
+} value_options[] = {
+    { "-o", OPT_OUT },
+    { "--output", OPT_OUT },
+    { "--width", OPT_WIDTH },
+    { "--height", OPT_HEIGHT },
+    { "--mode", OPT_MODE },
+    { "--depth", OPT_DEPTH },
+    { "--wavelengths", OPT_WAVELENGTHS },
+    { "--threads", OPT_THREADS },
+    { "--pfm", OPT_PFM },
+    { "--cutoff", OPT_CUTOFF },
+};
+
+static const char *set_value(rs_args *args, int id, const char *name,
+                             const char *val)
+{
+    switch (id) {
+    case OPT_OUT:
+    case OPT_PFM:
+        if (*val == '\0')
+            return fail(args, "%s: empty file name", name);
+        if (id == OPT_OUT)
+            args->out_png = val;
+        else
+            args->pfm = val;
+        return NULL;
+    case OPT_WIDTH:
+        return int_option(args, name, val, 1, RS_ARGS_SIZE_MAX, &args->width);
+    case OPT_HEIGHT:
+        return int_option(args, name, val, 1, RS_ARGS_SIZE_MAX, &args->height);
+    case OPT_DEPTH:
+        return int_option(args, name, val, 1, RS_ARGS_DEPTH_MAX, &args->depth);
+    case OPT_WAVELENGTHS:
+        return int_option(args, name, val, 1, RS_ARGS_WAVELENGTHS_MAX,
+                          &args->wavelengths);
+    case OPT_THREADS:
+        return int_option(args, name, val, 0, RS_ARGS_THREADS_MAX,
+                          &args->threads);
+    case OPT_MODE:
+        args->mode_auto = 0;
+        if (strcmp(val, "polarized") == 0)
+            args->mode = RS_MODE_POLARIZED;
+        else if (strcmp(val, "fresnel") == 0)
+            args->mode = RS_MODE_FRESNEL;
+        else if (strcmp(val, "schlick") == 0)
+            args->mode = RS_MODE_SCHLICK;
+        else if (strcmp(val, "rgb") == 0)
+            args->mode = RS_MODE_RGB;
+        else if (strcmp(val, "auto") == 0)
+            args->mode_auto = 1;
+        else
+            return fail(args, "%s: unknown mode '%s' (rgb, schlick, fresnel, "
+                        "polarized or auto)", name, val);
+        return NULL;
+    case OPT_CUTOFF: {
+        double v;
+        if (!parse_double(val, &v))
+            return fail(args, "%s: '%s' is not a finite number", name, val);
+        if (v < 0.0 || v > 1.0)
+            return fail(args, "%s: %s is out of range (0..1)", name, val);
+        args->cutoff = v;
+        return NULL;
+    }
+    default:
+        return fail(args, "%s: internal error", name);
+    }
+}
+
+/* The default output: the scene's base name, its last extension (if any,
+ * and not a leading dot) replaced by .png. */
+static const char *derive_output(rs_args *args)
+{
+    const char *base = args->scene, *dot = NULL;
+    size_t n;
+    for (const char *p = args->scene; *p; p++)
+        if (*p == '/')
+            base = p + 1;
+    if (*base == '\0')
+        return fail(args, "%s: the scene is not a file name", args->scene);
+    for (const char *p = base + 1; *p; p++)
+        if (*p == '.')
+            dot = p;
+    n = dot ? (size_t)(dot - base) : strlen(base);
+    if (n + sizeof ".png" > sizeof args->out_default)
+        return fail(args, "%s: the scene's name is too long", args->scene);
+    memcpy(args->out_default, base, n);
+    memcpy(args->out_default + n, ".png", sizeof ".png");
+    args->out_png = args->out_default;
+    return NULL;
+}
+
+const char *rs_args_parse(rs_args *args, int argc, char **argv)
+{
+    int options_done = 0;
+
+    /* --help and --version win over everything, errors included. */
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--") == 0)
+            break;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            args->help = 1;
+            return NULL;
+        }
+        if (strcmp(a, "--version") == 0 || strcmp(a, "-V") == 0) {
+            args->version = 1;
+            return NULL;
+        }
+    }
+
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *val = NULL;
+        int id = -1;
+        size_t len;
+
+        if (options_done || a[0] != '-' || a[1] == '\0') {
+            if (args->scene)
+                return fail(args, "more than one scene file ('%s' and '%s')",
+                            args->scene, a);
+            if (*a == '\0')
+                return fail(args, "empty scene file name");
+            args->scene = a;
+            continue;
+        }
+        if (strcmp(a, "--") == 0) {
+            options_done = 1;
+            continue;
+        }
+        if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
+            args->quiet = 1;
+            continue;
+        }
+        for (size_t k = 0; k < sizeof value_options / sizeof *value_options; k++) {
+            const char *name = value_options[k].name;
+            len = strlen(name);
+            if (strncmp(a, name, len) != 0)
+                continue;
+            if (a[len] == '\0') {
+                id = value_options[k].id;
+                if (i + 1 >= argc)
+                    return fail(args, "%s needs a value", name);
+                val = argv[++i];
+            } else if (a[len] == '=' && name[1] == '-') {
+                id = value_options[k].id;
+                val = a + len + 1;
+            } else {
+                continue;
+            }
+            if (set_value(args, id, name, val))
+                return args->error;
+            break;
+        }
+        if (id < 0) {
+            const char *eq = strchr(a, '=');
+            if (eq && a[1] == '-')
+                return fail(args, "unknown option '%.*s' (see --help)",
+                            (int)(eq - a), a);
+            return fail(args, "unknown option '%s' (see --help)", a);
+        }
+    }
+
+    if (!args->scene)
+        return fail(args, "no scene file given (usage: lensrender SCENE "
+                    "[options]; see --help)");
+    if ((long long)args->width * args->height > RS_ARGS_PIXELS_MAX)
+        return fail(args, "image %d x %d has more than %lld pixels",
+                    args->width, args->height, RS_ARGS_PIXELS_MAX);
+    if (!args->out_png && derive_output(args))
+        return args->error;
+    return NULL;
+}

@@ -1,0 +1,68 @@
+/* args.h -- the command line of lensrender, parsed into plain data
+ * (renderer-internal).
+ *
+ *   lensrender SCENE [-o OUT.png] [--width W] [--height H]
+ *              [--mode rgb|schlick|fresnel|polarized|auto] [--depth N]
+ *              [--wavelengths N] [--threads N] [--pfm OUT.pfm] [--quiet]
+ *              [--cutoff F]
+ *   lensrender --help | --version
+ *
+ * Parsing only: nothing here prints, exits, allocates or touches global
+ * state.  rs_args_parse returns NULL on success or a one-line message
+ * naming the problem, held in the caller's rs_args (rs_args.error), with
+ * no "lensrender: " prefix and no newline.  Strings point into argv,
+ * except out_png when it is derived from the scene's name (then it points
+ * into rs_args.out_default).
+ */
+#ifndef RS_ARGS_H
+#define RS_ARGS_H
+
+#include <stddef.h>
+
+#include "integrator.h"
+
+#define RS_ARGS_ERROR_MAX 512
+#define RS_ARGS_PATH_MAX 4096
+
+/* Limits of the options. */
+#define RS_ARGS_SIZE_MAX 16384                     /* --width, --height */
+#define RS_ARGS_PIXELS_MAX (64LL * 1024 * 1024)    /* W * H */
+#define RS_ARGS_DEPTH_MAX 256                      /* POV-Ray's max_trace_level */
+#define RS_ARGS_WAVELENGTHS_MAX 1024
+#define RS_ARGS_THREADS_MAX 1024
+
+typedef struct rs_args {
+    int help;             /* --help / -h: print usage; nothing else parsed */
+    int version;          /* --version / -V */
+    const char *scene;    /* the scene file (required) */
+    const char *out_png;  /* -o / --output; default: the scene's base name
+                             with its extension replaced by .png, in the
+                             current directory */
+    const char *pfm;      /* --pfm, or NULL */
+    int width, height;    /* 1..16384 each, W*H <= 64 Mi; default 320x240 */
+    int mode_auto;        /* --mode auto: the caller picks mode from the
+                             scene */
+    rs_mode mode;         /* default RS_MODE_POLARIZED */
+    int depth;            /* 1..256; 0 = the scene's max_trace_level */
+    int wavelengths;      /* 1..1024; default 16 */
+    int threads;          /* 1..1024; 0 = every online processor (default) */
+    double cutoff;        /* 0..1; < 0 = the scene's adc_bailout (default) */
+    int quiet;            /* --quiet / -q */
+    char out_default[RS_ARGS_PATH_MAX];
+    char error[RS_ARGS_ERROR_MAX];
+} rs_args;
+
+/* The defaults above (no scene). */
+void rs_args_init(rs_args *args);
+
+/* Parse argv[1..argc).  Accepts "--opt VALUE" and "--opt=VALUE" (and
+ * "-o VALUE"); "--" ends the options.  When --help/-h or --version/-V
+ * appears, only that flag is set (the first wins) and nothing else is
+ * checked or required.  Repeating an option keeps the last value.
+ * Returns NULL on success, else args->error. */
+const char *rs_args_parse(rs_args *args, int argc, char **argv);
+
+/* The option name of a mode: "polarized", "fresnel", "schlick", "rgb". */
+const char *rs_mode_name(rs_mode mode);
+
+#endif

@@ -1,0 +1,207 @@
+/* camera.c -- POV-Ray 3.7's perspective camera (see camera.h for the
+ * rules and their order). */
+#include "camera.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+
+/* POV-Ray's small number for its camera tests (EPSILON in its sources). */
+#define RS_CAMERA_EPSILON 1.0e-10
+/* Relative size under which D, R, U count as coplanar. */
+#define RS_CAMERA_COPLANAR 1.0e-12
+
+static const double rs_camera_pi = 3.14159265358979323846;
+
+static lp_vec3 v3(double x, double y, double z)
+{
+    lp_vec3 r = { x, y, z };
+    return r;
+}
+
+static lp_vec3 v_add(lp_vec3 a, lp_vec3 b)
+{
+    return v3(a.x + b.x, a.y + b.y, a.z + b.z);
+}
+
+static lp_vec3 v_sub(lp_vec3 a, lp_vec3 b)
+{
+    return v3(a.x - b.x, a.y - b.y, a.z - b.z);
+}
+
+static lp_vec3 v_scale(lp_vec3 a, double s)
+{
+    return v3(a.x * s, a.y * s, a.z * s);
+}
+
+static double v_dot(lp_vec3 a, lp_vec3 b)
+{
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+static lp_vec3 v_cross(lp_vec3 a, lp_vec3 b)
+{
+    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
+              a.x * b.y - a.y * b.x);
+}
+
+static double v_len(lp_vec3 a)
+{
+    return sqrt(v_dot(a, a));
+}
+
+/* a / |a|; the caller has checked |a| > 0. */
+static lp_vec3 v_unit(lp_vec3 a)
+{
+    double l = v_len(a);
+    return v3(a.x / l, a.y / l, a.z / l);
+}
+
+static int v_finite(lp_vec3 a)
+{
+    return isfinite(a.x) && isfinite(a.y) && isfinite(a.z);
+}
+
+static int fail(char *msg, size_t msg_size, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+static int fail(char *msg, size_t msg_size, const char *fmt, ...)
+{
+    if (msg && msg_size > 0) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, msg_size, fmt, ap);
+        va_end(ap);
+    }
+    return -1;
+}
+
+/* The checks every finished frame must pass (before and after the
+ * camera's transform). */
+static int check_frame(const rs_view *v, const char *when, char *msg,
+                       size_t msg_size)
+{
+    double ld, lr, lu, vol;
+    if (!v_finite(v->location) || !v_finite(v->D) || !v_finite(v->R) ||
+        !v_finite(v->U))
+        return fail(msg, msg_size, "camera: the camera vectors are not finite%s",
+                    when);
+    ld = v_len(v->D);
+    lr = v_len(v->R);
+    lu = v_len(v->U);
+    if (!(ld > 0.0))
+        return fail(msg, msg_size, "camera: the direction vector is zero%s", when);
+    if (!(lr > 0.0))
+        return fail(msg, msg_size, "camera: the right vector is zero%s", when);
+    if (!(lu > 0.0))
+        return fail(msg, msg_size,
+                    "camera: the up vector is zero%s (with look_at: the right "
+                    "vector is parallel to the view direction; set sky)",
+                    when);
+    vol = v_dot(v->D, v_cross(v->R, v->U));
+    if (!(fabs(vol) > RS_CAMERA_COPLANAR * ld * lr * lu))
+        return fail(msg, msg_size,
+                    "camera: direction, right and up are coplanar%s, so the "
+                    "image has no area", when);
+    return 0;
+}
+
+int rs_camera_setup(const rs_camera *cam, int width, int height,
+                    rs_view *out, char *msg, size_t msg_size)
+{
+    rs_view v;
+
+    if (!cam || !out)
+        return fail(msg, msg_size, "camera: no camera");
+    if (width < 1 || height < 1)
+        return fail(msg, msg_size, "camera: image size %d x %d is not positive",
+                    width, height);
+    if (!v_finite(cam->location) || !v_finite(cam->direction) ||
+        !v_finite(cam->right) || !v_finite(cam->up) || !v_finite(cam->sky) ||
+        (cam->has_look_at && !v_finite(cam->look_at)))
+        return fail(msg, msg_size, "camera: a camera vector is not finite");
+
+    v.location = cam->location;
+    v.D = cam->direction;
+    v.R = cam->right;
+    v.U = cam->up;
+
+    /* 1. up and right as given. */
+    if (!(v_len(v.R) > 0.0))
+        return fail(msg, msg_size, "camera: the right vector is zero");
+    if (!(v_len(v.U) > 0.0))
+        return fail(msg, msg_size, "camera: the up vector is zero");
+    if (!(v_len(v.D) > 0.0))
+        return fail(msg, msg_size, "camera: the direction vector is zero");
+
+    /* 2. angle: the full horizontal field of view across right. */
+    if (cam->has_angle) {
+        if (!isfinite(cam->angle))
+            return fail(msg, msg_size, "camera: the angle is not finite");
+        if (cam->angle < 0.0)
+            return fail(msg, msg_size, "camera: negative viewing angle %g",
+                        cam->angle);
+        if (cam->angle >= 180.0)
+            return fail(msg, msg_size,
+                        "camera: viewing angle %g must be smaller than 180 "
+                        "degrees", cam->angle);
+        if (cam->angle > 0.0) {
+            double half = cam->angle * (rs_camera_pi / 360.0);
+            /* evaluated in POV-Ray's order, for bit-equal vectors */
+            double dir_len = v_len(v.R) / tan(half) / 2.0;
+            v.D = v_scale(v_unit(v.D), dir_len);
+        }
+    }
+
+    /* 3. look_at. */
+    if (cam->has_look_at) {
+        double len_d = v_len(v.D), len_u = v_len(v.U), len_r = v_len(v.R);
+        /* The sign of the supplied frame: (U x D) . R > 0 for the default
+         * camera, < 0 for a mirrored right. */
+        double handed = v_dot(v_cross(v.U, v.D), v.R);
+        lp_vec3 to = v_sub(cam->look_at, cam->location);
+        lp_vec3 d_hat, r_new, r_hat;
+        if (v_dot(to, to) < RS_CAMERA_EPSILON)
+            return fail(msg, msg_size,
+                        "camera: location and look_at must be different");
+        d_hat = v_unit(to);
+        r_new = v_cross(cam->sky, d_hat);
+        if (fabs(r_new.x) < RS_CAMERA_EPSILON &&
+            fabs(r_new.y) < RS_CAMERA_EPSILON &&
+            fabs(r_new.z) < RS_CAMERA_EPSILON)
+            r_new = v.R; /* D parallel to sky: POV-Ray keeps the right */
+        r_hat = v_unit(r_new);
+        v.U = v_scale(v_cross(d_hat, r_hat), len_u);
+        v.D = v_scale(d_hat, len_d);
+        v.R = v_scale(r_hat, handed > 0.0 ? len_r : -len_r);
+    }
+
+    if (check_frame(&v, "", msg, msg_size) != 0)
+        return -1;
+
+    /* 4. the camera's own transforms. */
+    if (cam->has_xf) {
+        v.location = rs_xf_point(&cam->xf, v.location);
+        v.D = rs_xf_dir(&cam->xf, v.D);
+        v.R = rs_xf_dir(&cam->xf, v.R);
+        v.U = rs_xf_dir(&cam->xf, v.U);
+        if (check_frame(&v, " after the camera's transforms", msg, msg_size) != 0)
+            return -1;
+    }
+
+    *out = v;
+    return 0;
+}
+
+void rs_camera_ray(const rs_view *v, double px, double py, int width,
+                   int height, lp_vec3 *origin, lp_vec3 *dir)
+{
+    double x0 = px / (double)width - 0.5;
+    double y0 = 0.5 - py / (double)height;
+    lp_vec3 d = v_add(v_add(v->D, v_scale(v->R, x0)), v_scale(v->U, y0));
+    *origin = v->location;
+    *dir = v_unit(d);
+}

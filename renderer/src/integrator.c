@@ -1,0 +1,598 @@
+/* integrator.c -- Whitted-style backward tracing with lenses as single
+ * primitives, in four light models.
+ *
+ * Spectral modes trace one wavelength at a time ("a band"); the rgb mode
+ * traces three colour channels.  The unpolarized modes (fresnel, schlick,
+ * rgb) carry one number per ray; a lens hit becomes lp_backward_build and
+ * the sum of each query's exact weight times what its query ray sees.
+ * The polarized mode carries bundles of linearly polarized rays (lp_ray,
+ * origin and dir unused: they all arrive along the ray being traced): a
+ * lens hit becomes build -> trace every query ray -> gather its bundle;
+ * a polarizer projects each ray on its axis (Malus); a diffuse or
+ * emissive surface sends natural light as two orthogonal, mutually
+ * incoherent halves.  Each source has its own channel id ch (two per
+ * source, one per half); at the pixel, rays of a coherent source add as
+ * complex amplitudes sqrt(I) vp exp(i(2 pi op/lambda - pi kphi + phase)),
+ * all others as intensities.
+ *
+ * Optical path outside lenses: a surface point X seen along unit d
+ * starts its rays with the phase of a plane wave travelling along -d,
+ * op = -d.X, and every segment of length t adds n t (the scene medium is
+ * air, n = 1), so a ray's op is referred to the origin of the ray being
+ * traced, as lp_backward_gather expects of a bundle.
+ *
+ * Levels follow POV-Ray: the camera ray is level 1; a query ray of depth
+ * k from a lens hit at level L is level L + k; a ray that needs a level
+ * beyond max_trace_level is black.  A branch whose bound on its weight
+ * falls below the cut-off is not traced. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "camera.h"
+#include "integrator.h"
+#include "shapes.h"
+#include "spectrum.h"
+
+#define RS_MAX_FRAMES 400
+#define RS_PI 3.14159265358979323846
+
+enum { BAND_CONTINUUM, BAND_LINE, BAND_RGB };
+
+typedef struct band {
+    int kind;
+    double lambda;  /* continuum/line: the wavelength; rgb: the channel's */
+    int light;      /* BAND_LINE: the light */
+    int channel;    /* BAND_RGB */
+} band;
+
+typedef struct bundle {
+    lp_ray *r;
+    size_t n, cap;
+} bundle;
+
+struct rs_integrator {
+    const rs_scene *scene;
+    rs_render_opts opts;
+    rs_view view;
+    int max_level;
+    double cutoff;
+    int n_sources;              /* 2 + lights + objects */
+    unsigned char *coherent;    /* per source */
+    double *coherence;          /* per source: coherence length, 0 = infinite */
+    double *light_norm;         /* per light: rs_spectrum_norm of its spectrum */
+    double xyz_scale[3];        /* makes a white emitter exactly white */
+};
+
+typedef struct frame {
+    lp_backward *bw;
+    bundle child;
+    lp_result res;
+} frame;
+
+struct rs_worker {
+    const rs_integrator *it;
+    frame *frames[RS_MAX_FRAMES];
+    bundle pixel;
+};
+
+/* Source ids: 0 ambient, 1 background, 2 + k light k, 2 + L + i object i. */
+static int src_light(const rs_integrator *it, int k) { (void)it; return 2 + k; }
+static int src_object(const rs_integrator *it, int i) { return 2 + (int)it->scene->n_lights + i; }
+
+void rs_render_opts_init(rs_render_opts *o)
+{
+    o->mode = RS_MODE_POLARIZED;
+    o->depth = 0;
+    o->wavelengths = 16;
+    o->cutoff = -1.0;
+    o->width = 320;
+    o->height = 240;
+}
+
+int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_integrator **out,
+                         char *msg, size_t msg_size)
+{
+    rs_integrator *it = calloc(1, sizeof *it);
+    *out = NULL;
+    if (!it) {
+        snprintf(msg, msg_size, "out of memory");
+        return -1;
+    }
+    it->scene = scene;
+    it->opts = *opts;
+    if (it->opts.wavelengths < 1)
+        it->opts.wavelengths = 1;
+    it->max_level = opts->depth > 0 ? opts->depth : scene->settings.max_trace_level;
+    it->cutoff = opts->cutoff >= 0.0 ? opts->cutoff : scene->settings.adc_bailout;
+    if (rs_camera_setup(&scene->camera, opts->width, opts->height, &it->view, msg, msg_size)) {
+        free(it);
+        return -1;
+    }
+    it->n_sources = 2 + (int)scene->n_lights + (int)scene->n_objects;
+    it->coherent = calloc((size_t)it->n_sources, 1);
+    it->coherence = calloc((size_t)it->n_sources, sizeof *it->coherence);
+    it->light_norm = calloc(scene->n_lights + 1, sizeof *it->light_norm);
+    if (!it->coherent || !it->coherence || !it->light_norm) {
+        free(it->coherent);
+        free(it->coherence);
+        free(it->light_norm);
+        free(it);
+        snprintf(msg, msg_size, "out of memory");
+        return -1;
+    }
+    for (int s = 0; s < it->n_sources; s++)
+        it->coherent[s] = scene->settings.coherent != 0;
+    for (size_t k = 0; k < scene->n_lights; k++) {
+        rs_spectrum ls = scene->lights[k].spectrum;
+        ls.rgb = scene->lights[k].color;
+        it->light_norm[k] = rs_spectrum_norm(&ls);
+    }
+    /* The N wavelengths are the midpoints of N equal bands over 380-780 nm
+     * (no jitter: no noise, the same for every pixel).  The quadrature is
+     * normalized per XYZ component so that a white RGB emitter (1,1,1)
+     * gives exactly linear sRGB (1,1,1). */
+    {
+        rs_color white = {1, 1, 1};
+        rs_spectrum ws = {RS_SPECTRUM_RGB, white, 0.0, 0.0};
+        double target[3], got[3] = {0, 0, 0}, cmf[3];
+        int n = it->opts.wavelengths;
+        double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
+        rs_linear_srgb_to_xyz(&white, target);
+        for (int k = 0; k < n; k++) {
+            double lambda = RS_LAMBDA_MIN + dl * (k + 0.5);
+            double e = rs_spectrum_emission(&ws, lambda);
+            rs_cmf(lambda, cmf);
+            for (int c = 0; c < 3; c++)
+                got[c] += e * cmf[c] * dl;
+        }
+        for (int c = 0; c < 3; c++)
+            it->xyz_scale[c] = got[c] > 0.0 ? target[c] / got[c] : 1.0;
+    }
+    for (size_t k = 0; k < scene->n_lights; k++)
+        if (scene->lights[k].coherent) {
+            it->coherent[src_light(it, (int)k)] = 1;
+            it->coherence[src_light(it, (int)k)] = scene->lights[k].coherence_length;
+        }
+    *out = it;
+    return 0;
+}
+
+void rs_integrator_destroy(rs_integrator *it)
+{
+    if (!it)
+        return;
+    free(it->coherent);
+    free(it->coherence);
+    free(it->light_norm);
+    free(it);
+}
+
+rs_worker *rs_worker_create(const rs_integrator *it)
+{
+    rs_worker *w = calloc(1, sizeof *w);
+    if (w)
+        w->it = it;
+    return w;
+}
+
+void rs_worker_destroy(rs_worker *w)
+{
+    if (!w)
+        return;
+    for (int f = 0; f < RS_MAX_FRAMES; f++) {
+        if (!w->frames[f])
+            continue;
+        lp_backward_destroy(w->frames[f]->bw);
+        free(w->frames[f]->child.r);
+        lp_result_release(&w->frames[f]->res);
+        free(w->frames[f]);
+    }
+    free(w->pixel.r);
+    free(w);
+}
+
+static frame *get_frame(rs_worker *w, int f)
+{
+    if (f < 0 || f >= RS_MAX_FRAMES)
+        return NULL;
+    if (!w->frames[f]) {
+        frame *fr = calloc(1, sizeof *fr);
+        if (!fr)
+            return NULL;
+        if (lp_backward_create(&fr->bw, NULL) != LP_OK) {
+            free(fr);
+            return NULL;
+        }
+        lp_result_init(&fr->res);
+        w->frames[f] = fr;
+    }
+    return w->frames[f];
+}
+
+static lp_ray *bundle_push(bundle *b)
+{
+    if (b->n == b->cap) {
+        size_t cap = b->cap ? 2 * b->cap : 16;
+        lp_ray *r = realloc(b->r, cap * sizeof *r);
+        if (!r)
+            return NULL;
+        b->r = r;
+        b->cap = cap;
+    }
+    return &b->r[b->n++];
+}
+
+/* ---- small vector helpers ---- */
+static double dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static lp_vec3 cross(lp_vec3 a, lp_vec3 b)
+{
+    return (lp_vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+static lp_vec3 unit(lp_vec3 a)
+{
+    double l = sqrt(dot(a, a));
+    return l > 0.0 ? (lp_vec3){a.x / l, a.y / l, a.z / l} : a;
+}
+static lp_vec3 madd(lp_vec3 a, lp_vec3 b, double s)
+{
+    return (lp_vec3){a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
+}
+static double chan(rs_color c, int k) { return k == 0 ? c.r : (k == 1 ? c.g : c.b); }
+static rs_color mul(rs_color a, rs_color b) { return (rs_color){a.r * b.r, a.g * b.g, a.b * b.b}; }
+
+/* ---- what a band sees of colours, lights and glass ---- */
+
+/* Radiance of an emitter whose colour is c. */
+static double band_emission(const band *b, rs_color c)
+{
+    if (b->kind == BAND_RGB)
+        return chan(c, b->channel);
+    if (b->kind == BAND_LINE)
+        return 0.0;
+    rs_spectrum s = {RS_SPECTRUM_RGB, c, 0.0, 0.0};
+    return rs_spectrum_emission(&s, b->lambda);
+}
+
+static double band_reflectance(const band *b, rs_color c)
+{
+    if (b->kind == BAND_RGB)
+        return chan(c, b->channel);
+    return rs_reflectance(c, b->lambda);
+}
+
+static double band_light(const rs_integrator *it, const band *b, int k)
+{
+    const rs_light *l = &it->scene->lights[k];
+    if (b->kind == BAND_RGB)
+        return chan(l->color, b->channel);
+    if (b->kind == BAND_LINE)
+        return b->light == k ? 1.0 : 0.0;
+    if (l->spectrum.type == RS_SPECTRUM_LINE)
+        return 0.0;
+    rs_spectrum s = l->spectrum;
+    s.rgb = l->color; /* the colour, or the tint of a blackbody */
+    return rs_spectrum_emission_norm(&s, it->light_norm[k], b->lambda);
+}
+
+static rs_color pigment_at(const rs_pigment *p, lp_vec3 x)
+{
+    if (p->type != RS_PIGMENT_CHECKER)
+        return p->color[0];
+    lp_vec3 q = rs_xf_point(&p->to_pattern, x);
+    long s = (long)floor(q.x + 1e-10) + (long)floor(q.y + 1e-10) + (long)floor(q.z + 1e-10);
+    return p->color[(s & 1) ? 1 : 0];
+}
+
+/* Is the light at `to` visible from x?  Clear glass and polarizers cast
+ * no shadow (as in POV-Ray); a lens rim and opaque objects do. */
+static int visible(const rs_scene *sc, lp_vec3 x, lp_vec3 to)
+{
+    lp_vec3 d = {to.x - x.x, to.y - x.y, to.z - x.z};
+    double dist = sqrt(dot(d, d));
+    if (!(dist > 0.0))
+        return 1;
+    d = (lp_vec3){d.x / dist, d.y / dist, d.z / dist};
+    double eps = 1e-9 * (1.0 + sqrt(dot(x, x)));
+    for (size_t i = 0; i < sc->n_objects; i++) {
+        const rs_object *o = &sc->objects[i];
+        rs_hit h;
+        if (o->type == RS_OBJ_POLARIZER)
+            continue;
+        if (!rs_object_intersect(o, x, d, eps, dist, &h))
+            continue;
+        if (o->type != RS_OBJ_LENS || h.lens_surface == LP_SURFACE_RIM)
+            return 0;
+    }
+    return 1;
+}
+
+/* Light leaving a diffuse/emissive surface towards the viewer, per source:
+ * calls emit(source, radiance) for each non-zero source. */
+typedef void (*emit_fn)(void *ctx, int source, double radiance);
+
+static void shade(const rs_integrator *it, const band *b, const rs_hit *h, emit_fn emit, void *ctx)
+{
+    const rs_scene *sc = it->scene;
+    const rs_object *o = &sc->objects[h->object];
+    rs_color pig = pigment_at(&o->pigment, h->point);
+    double e = band_emission(b, mul(pig, o->finish.emission));
+    if (e != 0.0)
+        emit(ctx, src_object(it, h->object), e);
+    double a = band_emission(b, mul(pig, mul(o->finish.ambient, sc->settings.ambient_light)));
+    if (a != 0.0)
+        emit(ctx, 0, a);
+    if (o->finish.diffuse == 0.0 || sc->n_lights == 0)
+        return;
+    double rho = band_reflectance(b, pig) * o->finish.diffuse;
+    if (rho == 0.0)
+        return;
+    lp_vec3 x = madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
+    for (size_t k = 0; k < sc->n_lights; k++) {
+        const rs_light *l = &sc->lights[k];
+        lp_vec3 ld = unit((lp_vec3){l->position.x - x.x, l->position.y - x.y,
+                                    l->position.z - x.z});
+        double c = dot(ld, h->normal);
+        if (c <= 0.0)
+            continue;
+        double p = band_light(it, b, (int)k);
+        if (p == 0.0 || !visible(sc, x, l->position))
+            continue;
+        emit(ctx, src_light(it, (int)k), rho * c * p);
+    }
+}
+
+/* ---- the unpolarized modes: one number per ray ---- */
+
+static lp_mode lens_mode(const rs_integrator *it)
+{
+    return it->opts.mode == RS_MODE_SCHLICK ? LP_MODE_SCHLICK
+           : it->opts.mode == RS_MODE_POLARIZED ? LP_MODE_POLARIZED
+                                                : LP_MODE_FRESNEL;
+}
+
+static void emit_sum(void *ctx, int source, double radiance)
+{
+    (void)source;
+    *(double *)ctx += radiance;
+}
+
+static double trace_scalar(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level,
+                           double weight, int skip, int f)
+{
+    const rs_integrator *it = w->it;
+    const rs_scene *sc = it->scene;
+    rs_hit h;
+
+    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h))
+        return band_emission(b, sc->background);
+    const rs_object *ob = &sc->objects[h.object];
+    if (ob->type == RS_OBJ_LENS) {
+        int dT = it->max_level - level;
+        frame *fr = get_frame(w, f);
+        if (dT < 1 || !fr)
+            return 0.0;
+        lp_trace_args a;
+        lp_trace_args_init(&a);
+        a.mode = lens_mode(it);
+        a.max_depth = dT < LP_MAX_DEPTH ? dT : LP_MAX_DEPTH;
+        a.min_weight = weight > 0.0 ? it->cutoff / weight : INFINITY;
+        if (lp_backward_build(fr->bw, ob->lens, o, d, b->lambda, &a, NULL) != LP_OK)
+            return 0.0;
+        size_t nq = lp_backward_query_count(fr->bw);
+        const lp_query *q = lp_backward_queries(fr->bw);
+        double sum = 0.0;
+        for (size_t k = 0; k < nq; k++)
+            sum += q[k].weight * trace_scalar(w, b, q[k].origin, q[k].dir, level + q[k].depth,
+                                              weight * q[k].weight, -1, f + 1);
+        return sum;
+    }
+    if (ob->type == RS_OBJ_POLARIZER) {
+        /* Natural light through an ideal polarizer: half of it. */
+        if (f + 1 >= RS_MAX_FRAMES)
+            return 0.0;
+        return 0.5 * trace_scalar(w, b, h.point, d, level, 0.5 * weight, h.object, f + 1);
+    }
+    double sum = 0.0;
+    shade(it, b, &h, emit_sum, &sum);
+    return sum;
+}
+
+/* ---- the polarized mode: bundles ---- */
+
+typedef struct emit_ctx {
+    bundle *out;
+    lp_vec3 d;
+    double op;
+} emit_ctx;
+
+/* Natural light of one source as two orthogonal incoherent halves. */
+static void emit_halves(void *ctx, int source, double radiance)
+{
+    emit_ctx *e = ctx;
+    lp_vec3 h = fabs(e->d.y) < 0.9 ? (lp_vec3){0, 1, 0} : (lp_vec3){1, 0, 0};
+    lp_vec3 v1 = unit(cross(e->d, h)), v2 = cross(e->d, v1);
+    for (int half = 0; half < 2; half++) {
+        lp_ray *r = bundle_push(e->out);
+        if (!r)
+            return;
+        memset(r, 0, sizeof *r);
+        r->intensity = 0.5 * radiance;
+        r->vp = half ? v2 : v1;
+        r->op = e->op;
+        r->ch = 2u * (uint64_t)source + (uint64_t)half;
+    }
+}
+
+static void shift_op(bundle *out, size_t from, double dop)
+{
+    for (size_t i = from; i < out->n; i++)
+        out->r[i].op += dop;
+}
+
+static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
+                      int skip, int f, bundle *out)
+{
+    const rs_integrator *it = w->it;
+    const rs_scene *sc = it->scene;
+    rs_hit h;
+    size_t start = out->n;
+
+    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
+        emit_ctx e = {out, d, -dot(d, o)};
+        double L = band_emission(b, sc->background);
+        if (L != 0.0)
+            emit_halves(&e, 1, L);
+        return;
+    }
+    const rs_object *ob = &sc->objects[h.object];
+    frame *fr = get_frame(w, f);
+    if (!fr)
+        return;
+
+    if (ob->type == RS_OBJ_LENS) {
+        int dT = it->max_level - level;
+        if (dT < 1)
+            return;
+        lp_trace_args a;
+        lp_trace_args_init(&a);
+        a.mode = LP_MODE_POLARIZED;
+        a.max_depth = dT < LP_MAX_DEPTH ? dT : LP_MAX_DEPTH;
+        a.min_weight = weight > 0.0 ? it->cutoff / weight : INFINITY;
+        if (lp_backward_build(fr->bw, ob->lens, o, d, b->lambda, &a, NULL) != LP_OK)
+            return;
+        size_t nq = lp_backward_query_count(fr->bw);
+        const lp_query *q = lp_backward_queries(fr->bw);
+        for (size_t k = 0; k < nq; k++) {
+            fr->child.n = 0;
+            trace_pol(w, b, q[k].origin, q[k].dir, level + q[k].depth, weight * q[k].bound, -1,
+                      f + 1, &fr->child);
+            if (fr->child.n == 0)
+                continue;
+            lp_result_clear(&fr->res);
+            if (lp_backward_gather(fr->bw, k, fr->child.r, fr->child.n, &fr->res, NULL) != LP_OK)
+                continue;
+            for (size_t i = 0; i < fr->res.count; i++) {
+                lp_ray *r = bundle_push(out);
+                if (!r)
+                    return;
+                *r = fr->res.rays[i].ray;
+            }
+        }
+        shift_op(out, start, h.t);
+        return;
+    }
+    if (ob->type == RS_OBJ_POLARIZER) {
+        if (f + 1 >= RS_MAX_FRAMES)
+            return;
+        fr->child.n = 0;
+        trace_pol(w, b, h.point, d, level, weight, h.object, f + 1, &fr->child);
+        lp_vec3 ax = ob->u.polarizer.axis;
+        ax = unit(madd(ax, d, -dot(ax, d)));
+        for (size_t i = 0; i < fr->child.n; i++) {
+            lp_ray r = fr->child.r[i];
+            double c = dot(r.vp, ax);
+            if (c == 0.0)
+                continue;
+            r.intensity *= c * c;
+            r.vp = ax;
+            if (c < 0.0)
+                r.kphi += 1; /* the field now points along -axis */
+            lp_ray *p = bundle_push(out);
+            if (!p)
+                return;
+            *p = r;
+        }
+        shift_op(out, start, h.t);
+        return;
+    }
+    emit_ctx e = {out, d, -dot(d, o)};
+    shade(it, b, &h, emit_halves, &e);
+}
+
+/* Power seen at the pixel.  Rays of incoherent sources add intensities;
+ * rays of one coherent source and half (one ch) add as amplitudes, each
+ * pair with the visibility gamma = exp(-(dop/L)^2) of the source's
+ * coherence length L (gamma = 1 for L = 0, infinite):
+ *     P = sum_i I_i + sum_{i<j} 2 gamma_ij Re(A_i . conj A_j). */
+static double bundle_power(const rs_integrator *it, const bundle *bd, double lambda)
+{
+    double total = 0.0;
+    double k0 = 2.0 * RS_PI / (lambda * 1e-6);
+
+    for (size_t i = 0; i < bd->n; i++) {
+        const lp_ray *a = &bd->r[i];
+        total += a->intensity;
+        uint64_t src = a->ch / 2;
+        if (src >= (uint64_t)it->n_sources || !it->coherent[src] || a->intensity == 0.0)
+            continue;
+        double lc = it->coherence[src];
+        double pa = k0 * a->op - RS_PI * a->kphi + a->phase;
+        for (size_t j = i + 1; j < bd->n; j++) {
+            const lp_ray *b = &bd->r[j];
+            if (b->ch != a->ch || b->intensity == 0.0)
+                continue;
+            double dop = a->op - b->op;
+            double gamma = lc > 0.0 ? exp(-(dop / lc) * (dop / lc)) : 1.0;
+            if (gamma < 1e-12)
+                continue;
+            double pb = k0 * b->op - RS_PI * b->kphi + b->phase;
+            double vv = a->vp.x * b->vp.x + a->vp.y * b->vp.y + a->vp.z * b->vp.z;
+            total += 2.0 * gamma * sqrt(a->intensity * b->intensity) * vv * cos(pa - pb);
+        }
+    }
+    return total > 0.0 ? total : 0.0;
+}
+
+static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
+{
+    const rs_integrator *it = w->it;
+    if (it->opts.mode != RS_MODE_POLARIZED)
+        return trace_scalar(w, b, o, d, 1, 1.0, -1, 0);
+    w->pixel.n = 0;
+    trace_pol(w, b, o, d, 1, 1.0, -1, 0, &w->pixel);
+    return bundle_power(it, &w->pixel, b->lambda);
+}
+
+void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs_color *out)
+{
+    lp_vec3 o, d;
+    rs_camera_ray(&it->view, i + 0.5, j + 0.5, it->opts.width, it->opts.height, &o, &d);
+
+    if (it->opts.mode == RS_MODE_RGB) {
+        double v[3];
+        for (int c = 0; c < 3; c++) {
+            band b = {BAND_RGB, RS_RGB_LAMBDA[c], -1, c};
+            v[c] = band_value(w, &b, o, d);
+        }
+        *out = (rs_color){v[0], v[1], v[2]};
+        return;
+    }
+    double xyz[3] = {0, 0, 0}, cmf[3];
+    int n = it->opts.wavelengths;
+    double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
+    for (int k = 0; k < n; k++) {
+        double lambda = RS_LAMBDA_MIN + dl * (k + 0.5);
+        band b = {BAND_CONTINUUM, lambda, -1, -1};
+        double L = band_value(w, &b, o, d);
+        rs_cmf(lambda, cmf);
+        for (int c = 0; c < 3; c++)
+            xyz[c] += L * cmf[c] * dl * it->xyz_scale[c];
+    }
+    for (size_t k = 0; k < it->scene->n_lights; k++) {
+        const rs_light *l = &it->scene->lights[k];
+        if (l->spectrum.type != RS_SPECTRUM_LINE)
+            continue;
+        band b = {BAND_LINE, l->spectrum.line_nm, (int)k, -1};
+        double L = band_value(w, &b, o, d);
+        double lx[3];
+        rs_spectrum s = l->spectrum;
+        s.rgb = l->color; /* the tint of the line */
+        rs_spectrum_line_xyz(&s, lx);
+        for (int c = 0; c < 3; c++)
+            xyz[c] += L * lx[c];
+    }
+    rs_xyz_to_linear_srgb(xyz, out);
+}

@@ -1,0 +1,52 @@
+/* integrator.h -- Whitted-style backward tracing of a scene with lenses
+ * as single primitives, in four light models (renderer-internal).
+ *
+ * A pixel's value is linear sRGB (D65).  Spectral modes sample
+ * `wavelengths` wavelengths over 380-780 nm (the midpoints of equal bands:
+ * noise-free, the same for every pixel) plus the line wavelengths of
+ * monochromatic lights, weight them with the CIE 1931 2-degree observer to
+ * XYZ (normalized so that a white emitter renders exactly white) and
+ * convert to linear sRGB. */
+#ifndef RS_INTEGRATOR_H
+#define RS_INTEGRATOR_H
+
+#include <stddef.h>
+
+#include "scene.h"
+
+typedef enum rs_mode {
+    RS_MODE_POLARIZED = 0,
+    RS_MODE_FRESNEL,
+    RS_MODE_SCHLICK,
+    RS_MODE_RGB
+} rs_mode;
+
+typedef struct rs_render_opts {
+    rs_mode mode;
+    int depth;         /* max trace level; <= 0: the scene's max_trace_level */
+    int wavelengths;   /* spectral samples per pixel, default 16 */
+    double cutoff;     /* drop branches whose weight bound is below this;
+                          < 0: the scene's adc_bailout */
+    int width, height;
+} rs_render_opts;
+
+void rs_render_opts_init(rs_render_opts *o);
+
+typedef struct rs_integrator rs_integrator;
+typedef struct rs_worker rs_worker; /* per-thread scratch */
+
+/* The scene must outlive the integrator and stay unchanged.  Returns 0, or
+ * -1 with a message. */
+int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts,
+                         rs_integrator **out, char *msg, size_t msg_size);
+void rs_integrator_destroy(rs_integrator *it);
+
+rs_worker *rs_worker_create(const rs_integrator *it);
+void rs_worker_destroy(rs_worker *w);
+
+/* Linear sRGB of pixel (i, j), i = column from the left, j = row from the
+ * top.  Deterministic for a given scene, options and pixel. */
+void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j,
+                         rs_color *out);
+
+#endif

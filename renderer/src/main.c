@@ -1,0 +1,272 @@
+/* main.c -- lensrender: render a .scene file to a PNG (and a PFM).
+ *
+ * Exit status: 0 success; 1 the render or writing the output failed;
+ * 2 bad input (command line, scene file, camera).  Every message is one
+ * line on stderr starting "lensrender: ". */
+#define _POSIX_C_SOURCE 200809L
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "args.h"
+#include "camera.h"
+#include "image.h"
+#include "integrator.h"
+#include "parser.h"
+#include "scene.h"
+#include "tiles.h"
+
+#define EXIT_RENDER 1
+#define EXIT_BAD 2
+#define TILE_SIZE 16
+#define MSG_MAX 1024
+
+static const char *const usage_text[] = {
+"usage: lensrender SCENE [-o OUT.png] [--width W] [--height H]\n"
+"                  [--mode rgb|schlick|fresnel|polarized|auto] [--depth N]\n"
+"                  [--wavelengths N] [--threads N] [--pfm OUT.pfm] [--quiet]\n"
+"                  [--cutoff F]\n"
+"       lensrender --help | --version\n"
+"\n",
+"Renders SCENE, a POV-Ray-style .scene file with lenses, to an 8-bit sRGB\n"
+"PNG.  The image is the same whatever --threads is.\n"
+"\n"
+"  -o, --output FILE   the PNG to write (default: the scene's name with\n"
+"                      .png, in the current directory)\n"
+"  --width W           image width in pixels, 1..16384 (default 320)\n"
+"  --height H          image height in pixels, 1..16384 (default 240);\n"
+"                      W x H at most 64 Mi pixels\n",
+"  --mode MODE         light model (default polarized):\n"
+"                        polarized  spectral, polarization tracked through\n"
+"                                   every interface, coherent sources add\n"
+"                                   as amplitudes\n"
+"                        fresnel    spectral, unpolarized Fresnel per\n"
+"                                   interface (POV-Ray's model)\n"
+"                        schlick    spectral, Schlick's approximation\n"
+"                        rgb        three colour channels, unpolarized\n"
+"                        auto       polarized when the scene has a\n"
+"                                   polarizer, a polarized light or\n"
+"                                   coherence, else fresnel\n",
+"  --depth N           max trace level 1..256 (default: the scene's\n"
+"                      global_settings max_trace_level, 5 if none)\n"
+"  --wavelengths N     spectral samples per pixel, 1..1024 (default 16)\n"
+"  --cutoff F          drop branches whose weight is below F, 0..1\n"
+"                      (default: the scene's adc_bailout, 1/255 if none)\n"
+"  --threads N         worker threads, 1..1024 (default 0: every core)\n"
+"  --pfm FILE          also write linear float RGB (Portable FloatMap)\n"
+"  -q, --quiet         print nothing but errors\n"
+"  -h, --help          this text\n"
+"  -V, --version       the version\n"
+"\n"
+"Exit status: 0 success, 1 render or output failure, 2 bad input.\n",
+};
+
+static void say(const char *fmt_prefix, const char *msg)
+{
+    if (fmt_prefix)
+        fprintf(stderr, "lensrender: %s: %s\n", fmt_prefix, msg);
+    else
+        fprintf(stderr, "lensrender: %s\n", msg);
+}
+
+static double now_seconds(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* What --mode auto picks, and why (for the message). */
+static rs_mode auto_mode(const rs_scene *s, const char **why)
+{
+    for (size_t i = 0; i < s->n_objects; i++)
+        if (s->objects[i].type == RS_OBJ_POLARIZER) {
+            *why = "the scene has a polarizer";
+            return RS_MODE_POLARIZED;
+        }
+    for (size_t k = 0; k < s->n_lights; k++)
+        if (s->lights[k].polarized) {
+            *why = "the scene has a polarized light";
+            return RS_MODE_POLARIZED;
+        }
+    if (s->settings.coherent) {
+        *why = "the scene is coherent";
+        return RS_MODE_POLARIZED;
+    }
+    for (size_t k = 0; k < s->n_lights; k++)
+        if (s->lights[k].coherent) {
+            *why = "the scene has a coherent light";
+            return RS_MODE_POLARIZED;
+        }
+    *why = "no polarizer, polarized light or coherence in the scene";
+    return RS_MODE_FRESNEL;
+}
+
+/* ---- the render: tiles of pixels into an rs_image ---------------------- */
+
+typedef struct render_ctx {
+    const rs_integrator *it;
+    rs_image *img;
+} render_ctx;
+
+static void *worker_make(void *user)
+{
+    const render_ctx *c = user;
+    return rs_worker_create(c->it);
+}
+
+static void worker_free(void *worker)
+{
+    rs_worker_destroy(worker);
+}
+
+static void render_tile(void *user, void *worker, int x0, int y0, int x1,
+                        int y1)
+{
+    const render_ctx *c = user;
+    for (int j = y0; j < y1; j++)
+        for (int i = x0; i < x1; i++) {
+            rs_color col;
+            float *px = c->img->rgb + 3 * ((size_t)j * (size_t)c->img->width +
+                                           (size_t)i);
+            rs_integrator_pixel(c->it, worker, i, j, &col);
+            px[0] = (float)col.r;
+            px[1] = (float)col.g;
+            px[2] = (float)col.b;
+        }
+}
+
+/* Everything after the command line; returns the exit status. */
+static int run(const rs_args *a)
+{
+    char msg[MSG_MAX] = "";
+    rs_scene scene;
+    rs_parse_opts popts;
+    rs_view view;
+    rs_render_opts ropts;
+    rs_integrator *it = NULL;
+    rs_image img;
+    render_ctx ctx;
+    rs_mode mode = a->mode;
+    int depth, status = 0;
+    double t0 = now_seconds();
+
+    memset(&img, 0, sizeof img);
+    rs_scene_init(&scene);
+    rs_parse_opts_init(&popts);
+    popts.image_width = a->width;
+    popts.image_height = a->height;
+    if (rs_parse_file(a->scene, &popts, &scene, msg, sizeof msg) != 0) {
+        say(NULL, msg);
+        status = EXIT_BAD;
+        goto done;
+    }
+    if (rs_scene_prepare(&scene, msg, sizeof msg) != 0) {
+        say(NULL, msg);
+        status = EXIT_BAD;
+        goto done;
+    }
+    if (rs_camera_setup(&scene.camera, a->width, a->height, &view, msg,
+                        sizeof msg) != 0) {
+        say(a->scene, msg);
+        status = EXIT_BAD;
+        goto done;
+    }
+    if (a->mode_auto) {
+        const char *why = "";
+        mode = auto_mode(&scene, &why);
+        if (!a->quiet)
+            fprintf(stderr, "lensrender: mode auto: %s (%s)\n",
+                    rs_mode_name(mode), why);
+    }
+    depth = a->depth > 0 ? a->depth : scene.settings.max_trace_level;
+
+    rs_render_opts_init(&ropts);
+    ropts.mode = mode;
+    ropts.depth = a->depth;
+    ropts.wavelengths = a->wavelengths;
+    ropts.cutoff = a->cutoff;
+    ropts.width = a->width;
+    ropts.height = a->height;
+    if (rs_integrator_create(&scene, &ropts, &it, msg, sizeof msg) != 0) {
+        say(a->scene, msg);
+        status = EXIT_RENDER;
+        goto done;
+    }
+
+    if (rs_image_create(&img, a->width, a->height) != 0) {
+        say(NULL, "out of memory for the image");
+        status = EXIT_RENDER;
+        goto done;
+    }
+    ctx.it = it;
+    ctx.img = &img;
+    if (rs_render_tiles(a->width, a->height, TILE_SIZE, a->threads,
+                        worker_make, worker_free, render_tile, &ctx,
+                        a->quiet ? -1 : STDERR_FILENO) != 0) {
+        say(NULL, "the render failed (out of memory for a worker thread)");
+        status = EXIT_RENDER;
+        goto done;
+    }
+
+    if (rs_png_write(a->out_png, &img, msg, sizeof msg) != 0) {
+        say(NULL, msg);
+        status = EXIT_RENDER;
+        goto done;
+    }
+    if (a->pfm) {
+        if (rs_pfm_write(a->pfm, &img, msg, sizeof msg) != 0) {
+            say(NULL, msg);
+            status = EXIT_RENDER;
+            goto done;
+        }
+        if (!a->quiet)
+            fprintf(stderr, "lensrender: wrote %s\n", a->pfm);
+    }
+    if (!a->quiet)
+        fprintf(stderr,
+                "lensrender: wrote %s (%d x %d, %s, %d wavelengths, depth %d) "
+                "in %.2f s\n",
+                a->out_png, a->width, a->height, rs_mode_name(mode),
+                a->wavelengths, depth, now_seconds() - t0);
+
+done:
+    rs_image_free(&img);
+    rs_integrator_destroy(it);
+    rs_scene_free(&scene);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    rs_args *a = malloc(sizeof *a);
+    int status;
+    if (!a) {
+        say(NULL, "out of memory");
+        return EXIT_RENDER;
+    }
+    rs_args_init(a);
+    if (rs_args_parse(a, argc, argv)) {
+        say(NULL, a->error);
+        free(a);
+        return EXIT_BAD;
+    }
+    if (a->help) {
+        for (size_t i = 0; i < sizeof usage_text / sizeof *usage_text; i++)
+            fputs(usage_text[i], stdout);
+        free(a);
+        return fflush(stdout) == 0 ? 0 : EXIT_RENDER;
+    }
+    if (a->version) {
+        printf("lensrender (lensprim) %d.%d.%d\n", LP_VERSION_MAJOR,
+               LP_VERSION_MINOR, LP_VERSION_PATCH);
+        free(a);
+        return fflush(stdout) == 0 ? 0 : EXIT_RENDER;
+    }
+    status = run(a);
+    free(a);
+    return status;
+}

@@ -1,0 +1,176 @@
+/* scene.h -- the scene a .scene file describes (renderer-internal).
+ *
+ * The parser fills an rs_scene; the renderer reads it.  POV-Ray meaning
+ * throughout: left-handed coordinates (x right, y up, z into the screen),
+ * lengths in millimetres for lenses, colours linear RGB.  Transforms are
+ * affine maps from object space to world space, composed in the order the
+ * keywords appear (POV-Ray: each new transform applies after the ones
+ * before it). */
+#ifndef RS_SCENE_H
+#define RS_SCENE_H
+
+#include <stddef.h>
+
+#include "lensprim.h"
+
+typedef struct rs_color {
+    double r, g, b;
+} rs_color;
+
+/* x_world = m * x_object + t  (m row-major 3x3), with its inverse. */
+typedef struct rs_transform {
+    double m[3][3];
+    double t[3];
+    double inv_m[3][3]; /* inverse of m */
+    double inv_t[3];    /* x_object = inv_m * x_world + inv_t */
+} rs_transform;
+
+/* Where a construct was written, for messages. */
+typedef struct rs_loc {
+    const char *file;  /* owned by the scene (rs_scene.files) */
+    int line, column;  /* 1-based */
+} rs_loc;
+
+typedef enum rs_pigment_type {
+    RS_PIGMENT_SOLID = 0,
+    RS_PIGMENT_CHECKER
+} rs_pigment_type;
+
+typedef struct rs_pigment {
+    rs_pigment_type type;
+    rs_color color[2];      /* solid: color[0]; checker: the two colours */
+    rs_transform to_pattern;/* world -> pattern space: the inverse of the
+                               object's and the pigment's own transforms */
+} rs_pigment;
+
+typedef struct rs_finish {
+    rs_color ambient;       /* POV-Ray default 0.1 */
+    double diffuse;         /* POV-Ray default 0.6 */
+    rs_color emission;      /* default 0 */
+} rs_finish;
+
+/* A spectrum of an emitter.  RGB colours become spectra by the method in
+ * spectrum.h; a LINE is monochromatic (a delta of the given power). */
+typedef enum rs_spectrum_type {
+    RS_SPECTRUM_RGB = 0,
+    RS_SPECTRUM_BLACKBODY,
+    RS_SPECTRUM_LINE
+} rs_spectrum_type;
+
+typedef struct rs_spectrum {
+    rs_spectrum_type type;
+    rs_color rgb;           /* RGB: the colour; BLACKBODY/LINE: a tint
+                               multiplying the luminance scale (default 1) */
+    double temperature_k;   /* BLACKBODY */
+    double line_nm;         /* LINE */
+} rs_spectrum;
+
+typedef enum rs_object_type {
+    RS_OBJ_PLANE = 0,
+    RS_OBJ_SPHERE,
+    RS_OBJ_BOX,
+    RS_OBJ_DISC,
+    RS_OBJ_LENS,
+    RS_OBJ_POLARIZER
+} rs_object_type;
+
+typedef struct rs_object {
+    rs_object_type type;
+    rs_loc loc;
+    /* Geometry in object space (POV-Ray parameters as written). */
+    union {
+        struct { lp_vec3 normal; double distance; } plane;   /* n.x = d */
+        struct { lp_vec3 center; double radius; } sphere;
+        struct { lp_vec3 corner1, corner2; } box;
+        struct { lp_vec3 center, normal; double radius, hole; } disc;
+        struct {
+            lp_lens_desc desc;          /* radii, thickness, diameters, glass,
+                                           and the placement after transforms */
+            char glass_name[LP_GLASS_NAME_MAX]; /* "" when ior/sellmeier given */
+        } lens;
+        struct { lp_vec3 center, normal, axis; double radius; } polarizer;
+    } u;
+    rs_transform xf;        /* object -> world (identity when none);
+                               lenses and polarizers have it folded into
+                               their parameters already and keep identity */
+    rs_pigment pigment;
+    rs_finish finish;
+    lp_lens *lens;          /* RS_OBJ_LENS: created by rs_scene_prepare */
+} rs_object;
+
+typedef struct rs_light {
+    rs_loc loc;
+    lp_vec3 position;
+    rs_color color;         /* POV-Ray's colour (RGB spectrum by default) */
+    rs_spectrum spectrum;
+    int polarized;          /* 0: natural light */
+    lp_vec3 polarization;   /* when polarized: the field direction */
+    int coherent;           /* rays from this light add as amplitudes */
+    double coherence_length;/* mm; 0 = infinite.  Written `coherent L`.
+                               Two rays of the light whose optical paths
+                               differ by D interfere with visibility
+                               exp(-(D/L)^2). */
+} rs_light;
+
+/* The camera keywords as written; camera.c turns them into rays with
+ * POV-Ray's exact rules (up, right, angle, then look_at). */
+typedef struct rs_camera {
+    lp_vec3 location;       /* default <0,0,0> */
+    lp_vec3 direction;      /* default <0,0,1> */
+    lp_vec3 right;          /* default <1.33,0,0> */
+    lp_vec3 up;             /* default <0,1,0> */
+    lp_vec3 sky;            /* default <0,1,0> */
+    lp_vec3 look_at;
+    int has_look_at;
+    double angle;           /* degrees */
+    int has_angle;
+    rs_transform xf;        /* transforms applied to the camera */
+    int has_xf;
+} rs_camera;
+
+typedef struct rs_settings {
+    int max_trace_level;    /* default 5 */
+    double adc_bailout;     /* default 1/255 */
+    rs_color ambient_light; /* default 1 */
+    double assumed_gamma;   /* default 1.0 (read, not used) */
+    int coherent;           /* global: same-ch rays add as amplitudes */
+} rs_settings;
+
+typedef struct rs_scene {
+    rs_camera camera;
+    rs_color background;    /* default black */
+    rs_settings settings;
+    rs_object *objects;
+    size_t n_objects, cap_objects;
+    rs_light *lights;
+    size_t n_lights, cap_lights;
+    char **files;           /* names of the files read (for rs_loc) */
+    size_t n_files;
+    lp_catalog *catalog;    /* glasses for lenses */
+} rs_scene;
+
+/* Identity transform. */
+void rs_transform_identity(rs_transform *xf);
+/* Apply to a point / direction / normal (object -> world). */
+lp_vec3 rs_xf_point(const rs_transform *xf, lp_vec3 p);
+lp_vec3 rs_xf_dir(const rs_transform *xf, lp_vec3 d);
+lp_vec3 rs_xf_normal(const rs_transform *xf, lp_vec3 n); /* inverse transpose */
+/* world -> object */
+lp_vec3 rs_xf_inv_point(const rs_transform *xf, lp_vec3 p);
+lp_vec3 rs_xf_inv_dir(const rs_transform *xf, lp_vec3 d);
+/* out = b after a (first a, then b). */
+void rs_transform_compose(const rs_transform *a, const rs_transform *b, rs_transform *out);
+/* POV-Ray transforms: translate v; rotate v (degrees about x, then y,
+ * then z, left-handed); scale v.  Return 0 when the matrix is singular. */
+int rs_transform_translate(rs_transform *xf, lp_vec3 v);
+int rs_transform_rotate(rs_transform *xf, lp_vec3 degrees);
+int rs_transform_scale(rs_transform *xf, lp_vec3 s);
+
+void rs_scene_init(rs_scene *scene);
+/* Free everything the scene owns (lenses, catalog, arrays). */
+void rs_scene_free(rs_scene *scene);
+/* Create the lensprim lenses of all lens objects (after parsing).
+ * Returns 0, or -1 with a message "file:line:col: ..." in msg. */
+int rs_scene_prepare(rs_scene *scene, char *msg, size_t msg_size);
+
+#endif
