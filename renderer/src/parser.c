@@ -816,8 +816,31 @@ static int transform_kind(const rs_token *t)
     return XF_NONE;
 }
 
-/* translate|rotate|scale V as one step; *v gets the vector. */
-static int parse_transform_step(parser *p, rs_transform *step, lp_vec3 *v)
+static int xf_finite(const rs_transform *xf)
+{
+    for (int i = 0; i < 3; i++) {
+        if (!isfinite(xf->t[i]) || !isfinite(xf->inv_t[i]))
+            return 0;
+        for (int j = 0; j < 3; j++)
+            if (!isfinite(xf->m[i][j]) || !isfinite(xf->inv_m[i][j]))
+                return 0;
+    }
+    return 1;
+}
+
+/* *xf = step after *xf, refused when the result is not finite. */
+static int apply_step(parser *p, const rs_token *kw, rs_transform *xf, const rs_transform *step)
+{
+    rs_transform_compose(xf, step, xf);
+    if (!xf_finite(xf))
+        return error_at(p, kw->line, kw->column,
+                        "the transforms are too large: a value is not finite");
+    return 0;
+}
+
+/* translate|rotate|scale V as one step; *v gets the vector, *kw_out the
+ * keyword. */
+static int parse_transform_step(parser *p, rs_transform *step, lp_vec3 *v, rs_token *kw_out)
 {
     rs_token kw = take(p);
     int kind = transform_kind(&kw);
@@ -836,6 +859,7 @@ static int parse_transform_step(parser *p, rs_transform *step, lp_vec3 *v)
     if (!ok)
         return error_at(p, start.line, start.column,
                         "scale <%g,%g,%g> has a zero component", v->x, v->y, v->z);
+    *kw_out = kw;
     return 0;
 }
 
@@ -871,10 +895,11 @@ static int parse_pigment(parser *p, rs_pigment *pig, rs_transform *pat)
             break;
         if (transform_kind(t) != XF_NONE) {
             rs_transform step;
+            rs_token kw;
             lp_vec3 v;
-            if (parse_transform_step(p, &step, &v) != 0)
+            if (parse_transform_step(p, &step, &v, &kw) != 0 ||
+                apply_step(p, &kw, pat, &step) != 0)
                 return -1;
-            rs_transform_compose(pat, &step, pat);
         } else if (!has_pattern && is_id(t, "checker")) {
             take(p);
             pig->type = RS_PIGMENT_CHECKER;
@@ -984,10 +1009,11 @@ static int parse_texture(parser *p, rs_pigment *pig, rs_transform *pat, rs_finis
                 return -1;
         } else if (transform_kind(t) != XF_NONE) {
             rs_transform step;
+            rs_token kw;
             lp_vec3 v;
-            if (parse_transform_step(p, &step, &v) != 0)
+            if (parse_transform_step(p, &step, &v, &kw) != 0 ||
+                apply_step(p, &kw, pat, &step) != 0)
                 return -1;
-            rs_transform_compose(pat, &step, pat);
         } else {
             return expected(p, t, "pigment, finish, translate, rotate, scale or '}' in texture");
         }
@@ -1066,11 +1092,11 @@ static int parse_object_modifiers(parser *p, rs_object *o)
                 return -1;
         } else if (transform_kind(t) != XF_NONE) {
             rs_transform step;
+            rs_token kw;
             lp_vec3 v;
-            if (parse_transform_step(p, &step, &v) != 0)
+            if (parse_transform_step(p, &step, &v, &kw) != 0 ||
+                apply_step(p, &kw, &o->xf, &step) != 0 || apply_step(p, &kw, &pat, &step) != 0)
                 return -1;
-            rs_transform_compose(&o->xf, &step, &o->xf);
-            rs_transform_compose(&pat, &step, &pat);
         } else {
             snprintf(what, sizeof what,
                      "pigment, finish, texture, translate, rotate, scale or '}' in %s", name);
@@ -1087,6 +1113,11 @@ static int parse_object_modifiers(parser *p, rs_object *o)
         o->pigment.to_pattern.inv_t[i] = pat.t[i];
     }
     return close_block(p, name);
+}
+
+static int vec_finite(lp_vec3 v)
+{
+    return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
 }
 
 static lp_vec3 normalized(lp_vec3 v)
@@ -1224,7 +1255,7 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
     lp_lens_desc *d = &o->u.lens.desc;
     rs_transform xf;
     int have_r1 = 0, have_r2 = 0, have_t = 0, have_d = 0, have_glass = 0;
-    double k;
+    double k, r1, r2;
     lp_vec3 axis;
 
     lp_lens_desc_init(d);
@@ -1314,14 +1345,15 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
             if (check_glass(p, &m, &d->medium) != 0)
                 return -1;
         } else if (transform_kind(t) != XF_NONE) {
-            rs_token tk = *t;
             rs_transform step;
+            rs_token tk;
             lp_vec3 v;
-            if (parse_transform_step(p, &step, &v) != 0)
+            if (parse_transform_step(p, &step, &v, &tk) != 0)
                 return -1;
             if (transform_kind(&tk) == XF_SCALE && check_uniform(p, &tk, v, "lens") != 0)
                 return -1;
-            rs_transform_compose(&xf, &step, &xf);
+            if (apply_step(p, &tk, &xf, &step) != 0)
+                return -1;
         } else {
             return expected(p, t, "radius1, radius2, thickness, diameter, diameter2, glass, "
                                   "ior, sellmeier, medium, translate, rotate, scale or '}' "
@@ -1334,8 +1366,12 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
                             : "a glass (glass \"NAME\", ior or sellmeier)";
         return error_at(p, kw->line, kw->column, "lens: missing %s", missing);
     }
+    if (close_block(p, "lens") != 0)
+        return -1;
     /* Fold the transforms: front vertex at the local origin, axis +z. */
     k = xf_scale_factor(&xf);
+    r1 = d->radius1;
+    r2 = d->radius2;
     d->radius1 *= k;
     d->radius2 *= k;
     d->thickness *= k;
@@ -1344,7 +1380,12 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
     d->position = rs_xf_point(&xf, (lp_vec3){ 0.0, 0.0, 0.0 });
     axis = rs_xf_dir(&xf, (lp_vec3){ 0.0, 0.0, 1.0 });
     d->axis = (lp_vec3){ axis.x / k, axis.y / k, axis.z / k };
-    return close_block(p, "lens");
+    if ((isfinite(r1) && !isfinite(d->radius1)) || (isfinite(r2) && !isfinite(d->radius2)) ||
+        !isfinite(d->thickness) || !isfinite(d->diameter) || !isfinite(d->diameter2) ||
+        !vec_finite(d->position) || !vec_finite(d->axis))
+        return error_at(p, kw->line, kw->column,
+                        "lens: a value is not finite after the transforms");
+    return 0;
 }
 
 static int parse_polarizer(parser *p, rs_object *o, const rs_token *kw)
@@ -1382,14 +1423,15 @@ static int parse_polarizer(parser *p, rs_object *o, const rs_token *kw)
                 return -1;
             have_a = 1;
         } else if (transform_kind(t) != XF_NONE) {
-            rs_token tk = *t;
             rs_transform step;
+            rs_token tk;
             lp_vec3 v;
-            if (parse_transform_step(p, &step, &v) != 0)
+            if (parse_transform_step(p, &step, &v, &tk) != 0)
                 return -1;
             if (transform_kind(&tk) == XF_SCALE && check_uniform(p, &tk, v, "polarizer") != 0)
                 return -1;
-            rs_transform_compose(&xf, &step, &xf);
+            if (apply_step(p, &tk, &xf, &step) != 0)
+                return -1;
         } else {
             return expected(p, t, "center, normal, radius, axis, translate, rotate, scale or "
                                   "'}' in polarizer");
@@ -1412,6 +1454,9 @@ static int parse_polarizer(parser *p, rs_object *o, const rs_token *kw)
     o->u.polarizer.normal = n;
     o->u.polarizer.axis = normalized(a);
     o->u.polarizer.radius = r * k;
+    if (!vec_finite(o->u.polarizer.center) || !isfinite(o->u.polarizer.radius))
+        return error_at(p, kw->line, kw->column,
+                        "polarizer: a value is not finite after the transforms");
     return close_block(p, "polarizer");
 }
 
@@ -1478,10 +1523,11 @@ static int parse_camera(parser *p)
         }
         if (transform_kind(t) != XF_NONE) {
             rs_transform step;
+            rs_token kw;
             lp_vec3 v;
-            if (parse_transform_step(p, &step, &v) != 0)
+            if (parse_transform_step(p, &step, &v, &kw) != 0 ||
+                apply_step(p, &kw, &c->xf, &step) != 0)
                 return -1;
-            rs_transform_compose(&c->xf, &step, &c->xf);
             c->has_xf = 1;
             continue;
         }
@@ -1627,10 +1673,11 @@ static int parse_light(parser *p)
                 return -1;
         } else if (transform_kind(t) != XF_NONE) {
             rs_transform step;
+            rs_token tk;
             lp_vec3 v;
-            if (parse_transform_step(p, &step, &v) != 0)
+            if (parse_transform_step(p, &step, &v, &tk) != 0 ||
+                apply_step(p, &tk, &xf, &step) != 0)
                 return -1;
-            rs_transform_compose(&xf, &step, &xf);
         } else {
             return expected(p, t, "polarization, spectrum, coherent, translate, rotate, scale "
                                   "or '}' in light_source");
@@ -1639,6 +1686,9 @@ static int parse_light(parser *p)
     if (close_block(p, "light_source") != 0)
         return -1;
     l.position = rs_xf_point(&xf, l.position);
+    if (!vec_finite(l.position))
+        return error_at(p, kw.line, kw.column,
+                        "light_source: the position is not finite after the transforms");
     if (l.polarized)
         l.polarization = normalized(rs_xf_dir(&xf, l.polarization));
     l.spectrum.rgb = l.color;

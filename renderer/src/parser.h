@@ -46,6 +46,13 @@
  *          [medium ior N] translate rotate scale }   (R: 0 or inf = flat)
  *   polarizer { [center V] normal V radius F axis V translate rotate scale }
  *
+ * A later pigment or finish block modifies the object's current one (a new
+ * colour or checker replaces the pattern and its transforms); defaults are
+ * POV-Ray's: black pigment, finish ambient 0.1 diffuse 0.6 emission 0;
+ * checker without colours is blue then green.  Every number must stay
+ * finite: overflowing literals, arithmetic, functions and transform chains
+ * are errors.
+ *
  * Stored values: plane and disc normals are normalized (the plane is
  * n.x = D with the normalized n, as POV-Ray); box corners are sorted so
  * corner1 <= corner2.  A pigment's to_pattern maps world points to pattern

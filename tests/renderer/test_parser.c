@@ -676,6 +676,14 @@ static void test_errors(void)
     expect_error("lens { radius1 1 radius2 1 diameter 1 thickness 1 }", 1, 1,
                  "lens: missing a glass");
     expect_error("lens { thickness 0 }", 1, 18, "thickness must be positive");
+    expect_error("sphere { 0, 1 translate 1e308*x translate 1e308*x }", 1, 33,
+                 "the transforms are too large");
+    expect_error("sphere { 0, 1 pigment { scale 1e200 scale 1e200 } }", 1, 37,
+                 "the transforms are too large");
+    expect_error("lens { radius1 1e300 radius2 0 thickness 1 diameter 1 ior 1.5 scale 1e10 }",
+                 1, 1, "lens: a value is not finite after the transforms");
+    expect_error("light_source { 1e308*x, 1 scale 10 }", 1, 1,
+                 "light_source: the position is not finite");
 
     /* nesting: 64 levels pass, 65 are refused at the 65th '(' */
     n = snprintf(deep, sizeof deep, "#declare A = ");
