@@ -1,0 +1,641 @@
+/* test_render_physics.c -- whole renders checked against closed-form
+ * optics written here, never against the renderer's own output.
+ *
+ *   a. Radiometry of a lossless plane-parallel plate in front of a uniform
+ *      self-lit white plane: with every internal reflection summed
+ *      incoherently, a plate transmits
+ *          T = (1 - R)^2 (1 + R^2 + R^4 + ...) = (1 - R) / (1 + R)
+ *      per polarization (R the single-interface reflectance, the same on
+ *      both faces).  Checked to 1e-4 relative in the polarized, fresnel and
+ *      rgb modes (and schlick at exact normal incidence), each pixel
+ *      against the same render without the plate.  The small obliquity of
+ *      off-centre pixels (< 1 degree) is accounted for exactly: Rs, Rp from
+ *      Fresnel's equations at the pixel's ray angle; the polarized mode
+ *      averages T over s and p, the unpolarized models use R = (Rs+Rp)/2
+ *      per interface.  Then N-BK7 given by its Sellmeier coefficients
+ *      (lossless) in the rgb mode: T per channel at RS_RGB_LAMBDA[c].
+ *   b. Newton's rings of scenes/newtons_rings.scene: the dark rings of the
+ *      air film between a plano-convex lens (R = 1000 mm) and a flat plate
+ *      lie where the film is m half-wavelengths thick, r_m = sqrt(m lambda
+ *      R), lambda = 589.3 nm.  Found in the render to 2 %.
+ *   c. Crossed ideal polarizers in front of a light box: black to within
+ *      the exact oblique-incidence leak; with a strongly curved lens
+ *      between them, the leak has the four-fold symmetry of the set-up,
+ *      the dark extinction cross along both polarizer axes, and bright
+ *      diagonals.
+ *   d. The unpolarized fresnel model's known failure on the same set-up:
+ *      each polarizer passes half of "natural" light, so the crossed pair
+ *      passes 1/4 of the light box instead of (almost) nothing.
+ *
+ * Resolutions are small so that the whole program runs in a few seconds,
+ * also under the sanitizers. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "integrator.h"
+#include "parser.h"
+#include "scene.h"
+#include "spectrum.h"
+#include "tiles.h"
+
+#define PI 3.14159265358979323846
+
+/* ---- rendering helpers -------------------------------------------------- */
+
+typedef struct picture {
+    int w, h;
+    double *rgb; /* 3 per pixel, row-major from the top */
+} picture;
+
+typedef struct job {
+    const rs_integrator *it;
+    picture *pic;
+    const unsigned char *mask; /* NULL: every pixel */
+} job;
+
+static void *job_worker_make(void *user)
+{
+    const job *j = user;
+    return rs_worker_create(j->it);
+}
+
+static void job_worker_free(void *w)
+{
+    rs_worker_destroy(w);
+}
+
+static void job_tile(void *user, void *worker, int x0, int y0, int x1, int y1)
+{
+    const job *jb = user;
+    for (int j = y0; j < y1; j++)
+        for (int i = x0; i < x1; i++) {
+            size_t k = (size_t)j * (size_t)jb->pic->w + (size_t)i;
+            rs_color c = {0, 0, 0};
+            if (!jb->mask || jb->mask[k])
+                rs_integrator_pixel(jb->it, worker, i, j, &c);
+            jb->pic->rgb[3 * k + 0] = c.r;
+            jb->pic->rgb[3 * k + 1] = c.g;
+            jb->pic->rgb[3 * k + 2] = c.b;
+        }
+}
+
+static int load_scene(rs_scene *sc, const char *text, const char *path, int w, int h)
+{
+    char msg[1024] = "";
+    rs_parse_opts po;
+    rs_parse_opts_init(&po);
+    po.image_width = w;
+    po.image_height = h;
+    rs_scene_init(sc);
+    int rc = text ? rs_parse_string(text, "<test>", &po, sc, msg, sizeof msg)
+                  : rs_parse_file(path, &po, sc, msg, sizeof msg);
+    if (rc != 0 || rs_scene_prepare(sc, msg, sizeof msg) != 0) {
+        fprintf(stderr, "scene: %s\n", msg);
+        return -1;
+    }
+    return 0;
+}
+
+/* Render (the masked pixels of) a w x h picture of sc.  depth <= 0 and
+ * cutoff < 0 take the scene's settings. */
+static int render(const rs_scene *sc, rs_mode mode, int w, int h, int depth, double cutoff,
+                  int wavelengths, const unsigned char *mask, picture *pic)
+{
+    char msg[1024] = "";
+    rs_render_opts o;
+    rs_integrator *it = NULL;
+    rs_render_opts_init(&o);
+    o.mode = mode;
+    o.width = w;
+    o.height = h;
+    o.depth = depth;
+    o.cutoff = cutoff;
+    if (wavelengths > 0)
+        o.wavelengths = wavelengths;
+    pic->w = w;
+    pic->h = h;
+    pic->rgb = calloc((size_t)3 * (size_t)w * (size_t)h, sizeof *pic->rgb);
+    if (!pic->rgb)
+        return -1;
+    if (rs_integrator_create(sc, &o, &it, msg, sizeof msg) != 0) {
+        fprintf(stderr, "integrator: %s\n", msg);
+        return -1;
+    }
+    job jb = {it, pic, mask};
+    int rc = rs_render_tiles(w, h, 16, 2, job_worker_make, job_worker_free, job_tile, &jb, -1);
+    rs_integrator_destroy(it);
+    return rc;
+}
+
+static double px(const picture *p, int i, int j, int c)
+{
+    return p->rgb[3 * ((size_t)j * (size_t)p->w + (size_t)i) + (size_t)c];
+}
+
+static double luminance_at(const picture *p, int i, int j)
+{
+    return 0.2126 * px(p, i, j, 0) + 0.7152 * px(p, i, j, 1) + 0.0722 * px(p, i, j, 2);
+}
+
+/* The direction of pixel (i, j) of a square-pixel camera looking along +z
+ * (right = x * w/h, up = y, |D| = |right| / (2 tan(angle/2)), POV-Ray's
+ * rules written out here), as (x, y, z) unit components. */
+static void camera_dir_z(double angle_deg, int w, int h, int i, int j, double d[3])
+{
+    double rl = (double)w / (double)h;
+    double dl = rl / (2.0 * tan(angle_deg * PI / 360.0));
+    double a = ((i + 0.5) / w - 0.5) * rl, b = 0.5 - (j + 0.5) / h;
+    double n = sqrt(a * a + b * b + dl * dl);
+    d[0] = a / n;
+    d[1] = b / n;
+    d[2] = dl / n;
+}
+
+/* ---- Fresnel's equations (written here) -------------------------------- */
+
+/* Power reflectances of an interface from index 1 into n at incidence
+ * angle with cosine ci (no TIR possible). */
+static void fresnel_rs_rp(double n, double ci, double *rs, double *rp)
+{
+    double si2 = 1.0 - ci * ci;
+    double ct = sqrt(1.0 - si2 / (n * n));
+    double s = (ci - n * ct) / (ci + n * ct);
+    double p = (n * ci - ct) / (n * ci + ct);
+    *rs = s * s;
+    *rp = p * p;
+}
+
+/* Incoherent plate transmission, single-interface reflectance R (the same
+ * at both faces, by Stokes' relations). */
+static double plate_t(double r)
+{
+    return (1.0 - r) / (1.0 + r);
+}
+
+/* N-BK7 (Schott), Sellmeier, lambda in nm in air. */
+static const double BK7[6] = {1.03961212, 0.231792344, 1.01046945,
+                              0.00600069867, 0.0200179144, 103.560653};
+
+static double sellmeier(const double *k, double lambda_nm)
+{
+    double l2 = (lambda_nm * 1e-3) * (lambda_nm * 1e-3);
+    double n2 = 1.0;
+    for (int i = 0; i < 3; i++)
+        n2 += k[i] * l2 / (l2 - k[3 + i]);
+    return sqrt(n2);
+}
+
+/* ---- a. radiometry of a plate ------------------------------------------ */
+
+#define PLATE_W 5
+#define PLATE_H 5
+#define PLATE_ANGLE 2.0
+
+static const char *plate_scene_fmt =
+    "global_settings { max_trace_level 60 adc_bailout 1e-12 }\n"
+    "camera { location <0, 0, -100> look_at <0, 0, 0>\n"
+    "         right x*image_width/image_height angle %g }\n"
+    "background { rgb 0 }\n"
+    "%s\n"
+    "plane { z, 50 pigment { rgb 1 } finish { ambient 0 diffuse 0 emission 1 } }\n";
+
+static const char *plate_lens_const =
+    "lens { radius1 0 radius2 0 thickness 2 diameter 200 ior 1.5168 translate <0, 0, -1> }";
+
+static const char *plate_lens_bk7 =
+    "lens { radius1 0 radius2 0 thickness 2 diameter 200\n"
+    "       sellmeier { 1.03961212, 0.231792344, 1.01046945,\n"
+    "                   0.00600069867, 0.0200179144, 103.560653 }\n"
+    "       translate <0, 0, -1> }";
+
+/* Expected ratio plate / no plate for pixel direction cosine ci. */
+static double plate_expected(rs_mode mode, double n, double ci)
+{
+    double rs, rp;
+    fresnel_rs_rp(n, ci, &rs, &rp);
+    if (mode == RS_MODE_POLARIZED) /* s and p stay s and p: each its own series */
+        return 0.5 * (plate_t(rs) + plate_t(rp));
+    if (mode == RS_MODE_SCHLICK) { /* only used at normal incidence */
+        double r0 = (n - 1.0) / (n + 1.0);
+        return plate_t(r0 * r0);
+    }
+    return plate_t(0.5 * (rs + rp)); /* unpolarized models: mean R per face */
+}
+
+static void test_plate_case(const char *lens, const char *what, rs_mode mode, int centre_only,
+                            int sellmeier_glass)
+{
+    char text[2048];
+    rs_scene with, without;
+    picture pw = {0, 0, NULL}, pn = {0, 0, NULL};
+
+    snprintf(text, sizeof text, plate_scene_fmt, PLATE_ANGLE, lens);
+    int ok = load_scene(&with, text, NULL, PLATE_W, PLATE_H) == 0;
+    snprintf(text, sizeof text, plate_scene_fmt, PLATE_ANGLE, "");
+    ok = ok && load_scene(&without, text, NULL, PLATE_W, PLATE_H) == 0;
+    CHECK(ok, "%s: scenes load", what);
+    if (ok) {
+        ok = render(&with, mode, PLATE_W, PLATE_H, 0, 1e-15, 0, NULL, &pw) == 0 &&
+             render(&without, mode, PLATE_W, PLATE_H, 0, 1e-15, 0, NULL, &pn) == 0;
+        CHECK(ok, "%s: renders", what);
+    }
+    if (ok) {
+        double worst = 0.0;
+        for (int j = 0; j < PLATE_H; j++)
+            for (int i = 0; i < PLATE_W; i++) {
+                if (centre_only && (i != PLATE_W / 2 || j != PLATE_H / 2))
+                    continue;
+                double d[3];
+                camera_dir_z(PLATE_ANGLE, PLATE_W, PLATE_H, i, j, d);
+                for (int c = 0; c < 3; c++) {
+                    double n = sellmeier_glass ? sellmeier(BK7, RS_RGB_LAMBDA[c]) : 1.5168;
+                    double bg = px(&pn, i, j, c);
+                    double want = bg * plate_expected(mode, n, d[2]);
+                    double got = px(&pw, i, j, c);
+                    CHECK(bg > 0.5, "%s: background pixel (%d,%d) ch %d is lit: %g", what, i, j,
+                          c, bg);
+                    CHECK_REL(got, want, 1e-4, "%s: pixel (%d,%d) ch %d", what, i, j, c);
+                    double e = fabs(got - want) / want;
+                    if (e > worst)
+                        worst = e;
+                }
+            }
+        printf("plate %-34s worst relative error %.2e\n", what, worst);
+    }
+    free(pw.rgb);
+    free(pn.rgb);
+    rs_scene_free(&with);
+    rs_scene_free(&without);
+}
+
+static void test_plate(void)
+{
+    double n = 1.5168, r0 = (n - 1) / (n + 1);
+    printf("plate n = %.4f: R = %.6f, (1-R)/(1+R) = %.7f\n", n, r0 * r0, plate_t(r0 * r0));
+    for (int c = 0; c < 3; c++) {
+        double nc = sellmeier(BK7, RS_RGB_LAMBDA[c]), rc = (nc - 1) / (nc + 1);
+        printf("N-BK7 at %.1f nm: n = %.6f, (1-R)/(1+R) = %.7f\n", RS_RGB_LAMBDA[c], nc,
+               plate_t(rc * rc));
+    }
+    test_plate_case(plate_lens_const, "ior 1.5168, polarized", RS_MODE_POLARIZED, 0, 0);
+    test_plate_case(plate_lens_const, "ior 1.5168, fresnel", RS_MODE_FRESNEL, 0, 0);
+    test_plate_case(plate_lens_const, "ior 1.5168, rgb", RS_MODE_RGB, 0, 0);
+    test_plate_case(plate_lens_const, "ior 1.5168, schlick (centre)", RS_MODE_SCHLICK, 1, 0);
+    test_plate_case(plate_lens_bk7, "N-BK7 sellmeier, rgb", RS_MODE_RGB, 0, 1);
+}
+
+/* ---- b. Newton's rings --------------------------------------------------- */
+
+/* scenes/newtons_rings.scene: camera at y = 150 looking down, angle 1.6,
+ * right x*image_width/image_height; the lens's flat top at y = 4, its
+ * convex face (R = 1000) touching the plate at the origin. */
+#define NR_SIZE 241
+#define NR_ANGLE 1.6
+#define NR_CAM_H 150.0
+#define NR_LENS_T 4.0
+#define NR_R 1000.0
+#define NR_LAMBDA 589.3
+#define NR_BIN 0.005     /* mm^2 of r^2 per bin */
+#define NR_R2_MAX 3.70   /* mm^2: beyond the 6th dark ring (3.54) */
+
+/* The radius at which pixel (i, j)'s ray crosses the contact plane y = 0:
+ * it travels 146 mm of air at angle theta, then the 4 mm of glass at
+ * theta' (sin theta = n sin theta'), then a film of at most 1.5 um (whose
+ * contribution, < 2e-5 mm, is neglected). */
+static double nr_radius(int i, int j, double n)
+{
+    double d[3];
+    camera_dir_z(NR_ANGLE, NR_SIZE, NR_SIZE, i, j, d);
+    double st = sqrt(d[0] * d[0] + d[1] * d[1]), ct = d[2];
+    double st2 = st / n, ct2 = sqrt(1.0 - st2 * st2);
+    return (NR_CAM_H - NR_LENS_T) * st / ct + NR_LENS_T * st2 / ct2;
+}
+
+static void test_newtons_rings(void)
+{
+    char path[4096];
+    rs_scene sc;
+    picture pic = {0, 0, NULL};
+    double n = sellmeier(BK7, NR_LAMBDA);
+    int nb = (int)(NR_R2_MAX / NR_BIN) + 1;
+    unsigned char *mask = calloc((size_t)NR_SIZE * NR_SIZE, 1);
+    double *r2 = malloc((size_t)NR_SIZE * NR_SIZE * sizeof *r2);
+    double *sum = calloc((size_t)nb, sizeof *sum), *sum_r2 = calloc((size_t)nb, sizeof *sum_r2);
+    int *cnt = calloc((size_t)nb, sizeof *cnt);
+
+    snprintf(path, sizeof path, "%s/scenes/newtons_rings.scene", LP_SOURCE_DIR);
+    int ok = mask && r2 && sum && sum_r2 && cnt && load_scene(&sc, NULL, path, NR_SIZE, NR_SIZE) == 0;
+    CHECK(ok, "newtons_rings.scene loads");
+    if (!ok)
+        goto out;
+    for (int j = 0; j < NR_SIZE; j++)
+        for (int i = 0; i < NR_SIZE; i++) {
+            double r = nr_radius(i, j, n);
+            r2[(size_t)j * NR_SIZE + i] = r * r;
+            mask[(size_t)j * NR_SIZE + i] = r * r < NR_R2_MAX;
+        }
+    {
+        double mm_px = nr_radius(NR_SIZE / 2 + 1, NR_SIZE / 2, n);
+        printf("newton: n(589.3) = %.6f, %.5f mm per pixel at the film\n", n, mm_px);
+    }
+    /* One continuum sample: only the sodium line lights the scene, the
+     * continuum bands see black (no ambient, black background). */
+    ok = render(&sc, RS_MODE_POLARIZED, NR_SIZE, NR_SIZE, 0, -1.0, 1, mask, &pic) == 0;
+    CHECK(ok, "newtons_rings renders");
+    if (!ok)
+        goto out;
+
+    /* The radial profile: the mean luminance of the pixels in bins of
+     * equal width in r^2 (the fringes are periodic in r^2, period
+     * lambda R), each bin placed at its pixels' mean r^2. */
+    for (int j = 0; j < NR_SIZE; j++)
+        for (int i = 0; i < NR_SIZE; i++) {
+            size_t k = (size_t)j * NR_SIZE + i;
+            if (!mask[k])
+                continue;
+            int b = (int)(r2[k] / NR_BIN);
+            if (b >= nb)
+                continue;
+            sum[b] += luminance_at(&pic, i, j);
+            sum_r2[b] += r2[k];
+            cnt[b]++;
+        }
+    double prof[1024], x[1024], peak = 0.0;
+    int np = 0;
+    for (int b = 0; b < nb && np < 1024; b++)
+        if (cnt[b] > 0) {
+            prof[np] = sum[b] / cnt[b];
+            x[np] = sum_r2[b] / cnt[b];
+            if (prof[np] > peak)
+                peak = prof[np];
+            np++;
+        }
+    CHECK(peak > 0.0, "newton: the rings are lit (peak %g)", peak);
+
+    /* Dark rings: local minima of the profile, each the lowest within a
+     * sixth of a fringe period on either side, away from the central dark
+     * spot (m = 0); located by a least-squares parabola through the +-5
+     * bins around it. */
+    double period = NR_LAMBDA * 1e-6 * NR_R;
+    int half = (int)(period / 6.0 / NR_BIN);
+    int found = 0;
+    double rm[8];
+    for (int k = half; k < np - half && found < 8; k++) {
+        if (x[k] < 0.5 * period)
+            continue;
+        int is_min = 1;
+        for (int q = k - half; q <= k + half; q++)
+            if (prof[q] < prof[k])
+                is_min = 0;
+        if (!is_min)
+            continue;
+        /* fit y = a + b t + c t^2, t = x - x[k], over k-5..k+5 */
+        double s[5] = {0}, sy[3] = {0};
+        for (int q = k - 5; q <= k + 5; q++) {
+            double t = x[q] - x[k], tp = 1.0;
+            for (int e = 0; e < 5; e++) {
+                s[e] += tp;
+                if (e < 3)
+                    sy[e] += tp * prof[q];
+                tp *= t;
+            }
+        }
+        /* normal equations, 3x3, solved by Cramer's rule */
+        double m[3][3] = {{s[0], s[1], s[2]}, {s[1], s[2], s[3]}, {s[2], s[3], s[4]}};
+        double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        double db = m[0][0] * (sy[1] * m[2][2] - m[1][2] * sy[2]) -
+                    sy[0] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                    m[0][2] * (m[1][0] * sy[2] - sy[1] * m[2][0]);
+        double dc = m[0][0] * (m[1][1] * sy[2] - sy[1] * m[2][1]) -
+                    m[0][1] * (m[1][0] * sy[2] - sy[1] * m[2][0]) +
+                    sy[0] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        double bb = db / det, cc = dc / det;
+        double xm = x[k];
+        if (cc > 0.0 && fabs(bb / (2.0 * cc)) < 5.0 * NR_BIN)
+            xm = x[k] - bb / (2.0 * cc);
+        CHECK(prof[k] < 0.5 * peak, "newton: dark ring %d is dark: %g of peak %g", found + 1,
+              prof[k], peak);
+        rm[found++] = sqrt(xm);
+        k += half;
+    }
+    CHECK(found >= 5, "newton: found %d dark rings, want >= 5", found);
+    for (int m = 1; m <= 5 && m <= found; m++) {
+        double want = sqrt(m * NR_LAMBDA * 1e-6 * NR_R);
+        printf("newton: dark ring m=%d  r = %.4f mm  theory %.4f mm  error %+.3f %%\n", m,
+               rm[m - 1], want, 100.0 * (rm[m - 1] - want) / want);
+        CHECK_REL(rm[m - 1], want, 0.02, "newton: dark ring m=%d radius", m);
+    }
+out:
+    free(pic.rgb);
+    free(mask);
+    free(r2);
+    free(sum);
+    free(sum_r2);
+    free(cnt);
+    rs_scene_free(&sc);
+}
+
+/* ---- c, d. crossed polarizers -------------------------------------------- */
+
+#define XP_SIZE 61
+#define XP_ANGLE 16.0
+#define XP_BOX 100.0
+
+static const char *xp_scene_fmt =
+    "global_settings { max_trace_level 6 adc_bailout 0.001 }\n"
+    "camera { location <0, 0, -120> look_at <0, 0, 0> right x*image_width/image_height angle 16 }\n"
+    "background { rgb 0 }\n"
+    "%s"
+    "disc { <0, 0, 80>, z, 35  pigment { rgb 1 } finish { ambient 0 diffuse 0 emission 100 } }\n";
+
+static const char *xp_polarizers =
+    "polarizer { center <0, 0, -30> normal <0, 0, 1> radius 40 axis <1, 0, 0> }\n"
+    "polarizer { center <0, 0, 30> normal <0, 0, 1> radius 40 axis <0, 1, 0> }\n";
+
+/* Crossed ideal polarizers (axes x and y, normal z) seen along unit d:
+ * each passes the field component along its axis projected perpendicular
+ * to d, a_perp = (a - (a.d) d) / |...|.  The two projected axes are no
+ * longer orthogonal:
+ *     x_perp . y_perp = -dx dy / sqrt((1 - dx^2)(1 - dy^2)),
+ * so natural light (1/2 through the first) leaks
+ *     L(d) = 1/2 dx^2 dy^2 / ((1 - dx^2)(1 - dy^2)).
+ * (The dichroic-sheet form, the field perpendicular to the absorbing axis,
+ * normalize(d x absorbing axis), gives the same value for a crossed pair.)
+ * L grows with |dx| and |dy|, so the field's corner bounds it. */
+static double crossed_leak(const double d[3])
+{
+    double x2 = d[0] * d[0], y2 = d[1] * d[1];
+    return 0.5 * x2 * y2 / ((1.0 - x2) * (1.0 - y2));
+}
+
+static void test_crossed_no_lens(void)
+{
+    char text[2048];
+    rs_scene sp, sb;
+    picture pp = {0, 0, NULL}, pf = {0, 0, NULL}, pb = {0, 0, NULL};
+
+    /* the bound over the whole field: the image corner (not a pixel
+     * centre), d = normalize(R/2 + U/2 + D) */
+    double dl = 1.0 / (2.0 * tan(XP_ANGLE * PI / 360.0));
+    double nn = sqrt(0.5 + dl * dl);
+    double corner[3] = {0.5 / nn, 0.5 / nn, dl / nn};
+    double bound = crossed_leak(corner);
+    printf("crossed polarizers: field corner at %.2f deg off axis, leak bound %.3e of the box\n",
+           acos(corner[2]) * 180.0 / PI, bound);
+    CHECK(bound < 1e-3, "crossed: the leak bound %g is below the 1e-3 tolerance", bound);
+
+    snprintf(text, sizeof text, xp_scene_fmt, xp_polarizers);
+    int ok = load_scene(&sp, text, NULL, XP_SIZE, XP_SIZE) == 0;
+    snprintf(text, sizeof text, xp_scene_fmt, "");
+    ok = ok && load_scene(&sb, text, NULL, XP_SIZE, XP_SIZE) == 0;
+    CHECK(ok, "crossed polarizers: scenes load");
+    if (!ok)
+        goto out;
+    ok = render(&sp, RS_MODE_POLARIZED, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pp) == 0 &&
+         render(&sp, RS_MODE_FRESNEL, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pf) == 0 &&
+         render(&sb, RS_MODE_POLARIZED, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pb) == 0;
+    CHECK(ok, "crossed polarizers: renders");
+    if (!ok)
+        goto out;
+
+    int lit = 0;
+    double worst_leak = 0.0, worst_model = 0.0, worst_quarter = 0.0;
+    for (int j = 0; j < XP_SIZE; j++)
+        for (int i = 0; i < XP_SIZE; i++) {
+            double d[3];
+            camera_dir_z(XP_ANGLE, XP_SIZE, XP_SIZE, i, j, d);
+            double leak = crossed_leak(d);
+            for (int c = 0; c < 3; c++) {
+                double box = px(&pb, i, j, c), got = px(&pp, i, j, c);
+                if (box > 0.5 * XP_BOX)
+                    lit++;
+                /* c. black: below 1e-3 of the box everywhere */
+                CHECK(got < 1e-3 * XP_BOX && got >= 0.0,
+                      "crossed, polarized: pixel (%d,%d) ch %d = %g, box %g", i, j, c, got, box);
+                if (got / XP_BOX > worst_leak)
+                    worst_leak = got / XP_BOX;
+                /* ... and exactly the ideal polarizers' oblique leak */
+                CHECK_ABS(got, box * leak, 1e-6 * box * leak + 1e-12 * XP_BOX,
+                          "crossed, polarized: pixel (%d,%d) ch %d vs oblique leak", i, j, c);
+                if (box > 0.0 && leak > 0.0 && fabs(got - box * leak) / (box * leak) > worst_model)
+                    worst_model = fabs(got - box * leak) / (box * leak);
+                /* d. the unpolarized model: 1/2 * 1/2 of the box */
+                double f = px(&pf, i, j, c);
+                CHECK_ABS(f, 0.25 * box, 1e-9 * XP_BOX,
+                          "crossed, fresnel: pixel (%d,%d) ch %d is box/4", i, j, c);
+                if (box > 0.5 * XP_BOX && fabs(f / box - 0.25) > worst_quarter)
+                    worst_quarter = fabs(f / box - 0.25);
+            }
+        }
+    lit /= 3;
+    CHECK(lit > XP_SIZE * XP_SIZE / 4, "crossed: the box fills %d pixels", lit);
+    printf("crossed, no lens: %d pixels see the box; polarized max %.3e of the box, "
+           "max rel. deviation from the oblique leak %.1e; fresnel = box/4 to %.1e "
+           "(the unpolarized model's failure: a real crossed pair is dark)\n",
+           lit, worst_leak, worst_model, worst_quarter);
+out:
+    free(pp.rgb);
+    free(pf.rgb);
+    free(pb.rgb);
+    rs_scene_free(&sp);
+    rs_scene_free(&sb);
+}
+
+static void test_crossed_lens(void)
+{
+    char path[4096];
+    rs_scene sc;
+    picture p = {0, 0, NULL};
+    const int N = XP_SIZE, c0 = XP_SIZE / 2;
+
+    snprintf(path, sizeof path, "%s/scenes/crossed_polarizers.scene", LP_SOURCE_DIR);
+    int ok = load_scene(&sc, NULL, path, N, N) == 0;
+    CHECK(ok, "crossed_polarizers.scene loads");
+    if (!ok)
+        return;
+    ok = render(&sc, RS_MODE_POLARIZED, N, N, 0, -1.0, 0, NULL, &p) == 0;
+    CHECK(ok, "crossed_polarizers.scene renders");
+    if (!ok)
+        goto out;
+
+    /* Symmetry: the lens is rotationally symmetric and every camera ray is
+     * meridional, so the lens's Jones matrix is diagonal in (s, p) and the
+     * leak is 1/2 |x . J y|^2 ~ sin^2(2 phi): mirror-symmetric in both
+     * axes, and (transposition swaps polarizer and analyzer, which leaves
+     * |x . J y| unchanged because J is symmetric) in the diagonals.  The
+     * camera rays of mirrored / transposed pixels are mirror images exactly
+     * (odd square image, right = x, up = y).  Compared to 1e-6 relative,
+     * with a floor of 1e-12 of the box for pixels that are zero up to
+     * rounding (the dark cross). */
+    double vmax = 0.0, worst_sym = 0.0;
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++)
+            for (int c = 0; c < 3; c++)
+                if (px(&p, i, j, c) > vmax)
+                    vmax = px(&p, i, j, c);
+    for (int j = 0; j < N; j++)
+        for (int i = 0; i < N; i++)
+            for (int c = 0; c < 3; c++) {
+                double v = px(&p, i, j, c);
+                double other[3] = {px(&p, N - 1 - i, j, c), px(&p, i, N - 1 - j, c),
+                                   px(&p, j, i, c)};
+                static const char *const name[3] = {"x-mirror", "y-mirror", "transpose"};
+                for (int s = 0; s < 3; s++) {
+                    double tol = 1e-6 * fmax(fabs(v), fabs(other[s])) + 1e-12 * XP_BOX;
+                    CHECK_ABS(v, other[s], tol, "lens leak %s symmetry at (%d,%d) ch %d", name[s],
+                              i, j, c);
+                    double e = fabs(v - other[s]) / fmax(fmax(fabs(v), fabs(other[s])), 1e-300);
+                    if (fmax(fabs(v), fabs(other[s])) > 1e-6 * vmax && e > worst_sym)
+                        worst_sym = e;
+                }
+            }
+
+    /* The extinction cross: the central row and column (rays in the
+     * planes of the polarizer axes, pure s or p) are dark next to the
+     * diagonal maximum. */
+    double diag_max = 0.0, axis_max = 0.0;
+    for (int k = 0; k < N; k++) {
+        diag_max = fmax(diag_max, fmax(luminance_at(&p, k, k), luminance_at(&p, k, N - 1 - k)));
+        axis_max = fmax(axis_max, fmax(luminance_at(&p, k, c0), luminance_at(&p, c0, k)));
+    }
+    CHECK(diag_max > 1e-3 * XP_BOX, "lens leak: the diagonals are lit (max %g)", diag_max);
+    CHECK(axis_max < 1e-3 * diag_max, "lens leak: the polarizer axes are dark: %g vs diagonal %g",
+          axis_max, diag_max);
+
+    /* Bright diagonals: of two pixels at the same distance from the centre
+     * (i^2 + j^2 equal), the one nearer a diagonal (larger sin^2 2phi) is
+     * the brighter. */
+    static const int pairs[][4] = {{5, 5, 7, 1}, {7, 4, 8, 1}, {10, 5, 11, 2},
+                                   {11, 10, 14, 5}, {13, 9, 15, 5}, {12, 5, 13, 0}};
+    for (size_t q = 0; q < sizeof pairs / sizeof *pairs; q++) {
+        int a = pairs[q][0], b = pairs[q][1], e = pairs[q][2], f = pairs[q][3];
+        double s1 = 2.0 * a * b / (double)(a * a + b * b), s2 = 2.0 * e * f / (double)(e * e + f * f);
+        double l1 = luminance_at(&p, c0 + a, c0 - b), l2 = luminance_at(&p, c0 + e, c0 - f);
+        printf("lens leak at (%+d,%+d) sin2phi %.3f: %.4e   at (%+d,%+d) sin2phi %.3f: %.4e\n", a,
+               b, s1, l1, e, f, s2, l2);
+        CHECK(l1 > l2, "lens leak: (%d,%d) nearer the diagonal is brighter than (%d,%d): %g vs %g",
+              a, b, e, f, l1, l2);
+    }
+    printf("crossed, lens: diagonal max %.4e, axis max %.3e (ratio %.2e), worst symmetry "
+           "error %.2e\n",
+           diag_max, axis_max, axis_max / diag_max, worst_sym);
+out:
+    free(p.rgb);
+    rs_scene_free(&sc);
+}
+
+int main(void)
+{
+    test_plate();
+    test_newtons_rings();
+    test_crossed_no_lens();
+    test_crossed_lens();
+    return check_finish("test_render_physics");
+}
