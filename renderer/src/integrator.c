@@ -63,7 +63,7 @@ struct rs_integrator {
     unsigned char *coherent;    /* per source */
     double *coherence;          /* per source: coherence length, 0 = infinite */
     double *light_norm;         /* per light: rs_spectrum_norm of its spectrum */
-    double xyz_scale[3];        /* makes a white emitter exactly white */
+    double correction[3][3];    /* C^-1: makes every RGB emitter exact */
 };
 
 typedef struct frame {
@@ -90,6 +90,22 @@ void rs_render_opts_init(rs_render_opts *o)
     o->cutoff = -1.0;
     o->width = 320;
     o->height = 240;
+}
+
+/* Invert a 3x3 matrix; 0 if singular. */
+static int invert3(const double a[3][3], double out[3][3])
+{
+    double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
+                 a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+                 a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if (!(fabs(det) > 1e-12))
+        return 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            int i1 = (j + 1) % 3, i2 = (j + 2) % 3, j1 = (i + 1) % 3, j2 = (i + 2) % 3;
+            out[i][j] = (a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]) / det;
+        }
+    return 1;
 }
 
 int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_integrator **out,
@@ -131,25 +147,41 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
         it->light_norm[k] = rs_spectrum_norm(&ls);
     }
     /* The N wavelengths are the midpoints of N equal bands over 380-780 nm
-     * (no jitter: no noise, the same for every pixel).  The quadrature is
-     * normalized per XYZ component so that a white RGB emitter (1,1,1)
-     * gives exactly linear sRGB (1,1,1). */
+     * (no jitter: no noise, the same for every pixel).  Emitter spectra
+     * are linear in their RGB (rs_emission_shape), so the colour error of
+     * this quadrature is one 3x3 matrix C: column k is the linear sRGB the
+     * quadrature gives the unit emitter of channel k.  Pixels are
+     * multiplied by C^-1, and every RGB emitter seen directly or through
+     * clear glass renders as exactly its RGB, white included. */
     {
-        rs_color white = {1, 1, 1};
-        rs_spectrum ws = {RS_SPECTRUM_RGB, white, 0.0, 0.0};
-        double target[3], got[3] = {0, 0, 0}, cmf[3];
+        double C[3][3], cmf[3];
         int n = it->opts.wavelengths;
         double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
-        rs_linear_srgb_to_xyz(&white, target);
-        for (int k = 0; k < n; k++) {
-            double lambda = RS_LAMBDA_MIN + dl * (k + 0.5);
-            double e = rs_spectrum_emission(&ws, lambda);
-            rs_cmf(lambda, cmf);
-            for (int c = 0; c < 3; c++)
-                got[c] += e * cmf[c] * dl;
+        for (int k = 0; k < 3; k++) {
+            rs_color unit = {k == 0, k == 1, k == 2};
+            rs_spectrum us = {RS_SPECTRUM_RGB, unit, 0.0, 0.0};
+            double xyz[3] = {0, 0, 0};
+            rs_color rgb;
+            for (int m = 0; m < n; m++) {
+                double lambda = RS_LAMBDA_MIN + dl * (m + 0.5);
+                double e = rs_spectrum_emission(&us, lambda);
+                rs_cmf(lambda, cmf);
+                for (int c = 0; c < 3; c++)
+                    xyz[c] += e * cmf[c] * dl;
+            }
+            rs_xyz_to_linear_srgb(xyz, &rgb);
+            C[0][k] = rgb.r;
+            C[1][k] = rgb.g;
+            C[2][k] = rgb.b;
         }
-        for (int c = 0; c < 3; c++)
-            it->xyz_scale[c] = got[c] > 0.0 ? target[c] / got[c] : 1.0;
+        if (!invert3(C, it->correction)) {
+            snprintf(msg, msg_size, "internal error: singular colour quadrature");
+            free(it->coherent);
+            free(it->coherence);
+            free(it->light_norm);
+            free(it);
+            return -1;
+        }
     }
     for (size_t k = 0; k < scene->n_lights; k++)
         if (scene->lights[k].coherent) {
@@ -570,7 +602,7 @@ void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs
         *out = (rs_color){v[0], v[1], v[2]};
         return;
     }
-    double xyz[3] = {0, 0, 0}, cmf[3];
+    double xyz[3] = {0, 0, 0}, lines[3] = {0, 0, 0}, cmf[3];
     int n = it->opts.wavelengths;
     double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
     for (int k = 0; k < n; k++) {
@@ -579,8 +611,9 @@ void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs
         double L = band_value(w, &b, o, d);
         rs_cmf(lambda, cmf);
         for (int c = 0; c < 3; c++)
-            xyz[c] += L * cmf[c] * dl * it->xyz_scale[c];
+            xyz[c] += L * cmf[c] * dl;
     }
+    /* Lines are exact deltas: no quadrature, no correction. */
     for (size_t k = 0; k < it->scene->n_lights; k++) {
         const rs_light *l = &it->scene->lights[k];
         if (l->spectrum.type != RS_SPECTRUM_LINE)
@@ -592,7 +625,13 @@ void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs
         s.rgb = l->color; /* the tint of the line */
         rs_spectrum_line_xyz(&s, lx);
         for (int c = 0; c < 3; c++)
-            xyz[c] += L * lx[c];
+            lines[c] += L * lx[c];
     }
-    rs_xyz_to_linear_srgb(xyz, out);
+    rs_color raw, rl;
+    rs_xyz_to_linear_srgb(xyz, &raw);
+    rs_xyz_to_linear_srgb(lines, &rl);
+    const double(*M)[3] = it->correction;
+    out->r = M[0][0] * raw.r + M[0][1] * raw.g + M[0][2] * raw.b + rl.r;
+    out->g = M[1][0] * raw.r + M[1][1] * raw.g + M[1][2] * raw.b + rl.g;
+    out->b = M[2][0] * raw.r + M[2][1] * raw.g + M[2][2] * raw.b + rl.b;
 }

@@ -693,6 +693,17 @@ double rs_reflectance(rs_color c, double lambda_nm)
     return s;
 }
 
+double rs_emission_shape(rs_color c, double lambda_nm)
+{
+    /* Smits' red, green and blue spectra divided by their sum: three
+     * non-negative functions that add up to exactly 1 at every wavelength,
+     * so the map is linear in c and white is flat. */
+    int bin = smits_bin(lambda_nm);
+    double r = smits_basis[SM_RED][bin], g = smits_basis[SM_GREEN][bin];
+    double b = smits_basis[SM_BLUE][bin], sum = r + g + b;
+    return (nonneg(c.r) * r + nonneg(c.g) * g + nonneg(c.b) * b) / sum;
+}
+
 /* ---- Black body -------------------------------------------------------- */
 
 double rs_planck(double temperature_k, double lambda_nm)
@@ -777,22 +788,8 @@ double rs_spectrum_emission_norm(const rs_spectrum *s, double norm,
                                  double lambda_nm)
 {
     switch (s->type) {
-    case RS_SPECTRUM_RGB: {
-        rs_color c = s->rgb;
-        double m = c.r;
-        if (c.g > m)
-            m = c.g;
-        if (c.b > m)
-            m = c.b;
-        if (!(m > 0.0))
-            return 0.0;
-        if (m <= 1.0)
-            return norm * rs_d65(lambda_nm) * rs_reflectance(c, lambda_nm);
-        c.r /= m;
-        c.g /= m;
-        c.b /= m;
-        return norm * m * rs_d65(lambda_nm) * rs_reflectance(c, lambda_nm);
-    }
+    case RS_SPECTRUM_RGB:
+        return norm * rs_d65(lambda_nm) * rs_emission_shape(s->rgb, lambda_nm);
     case RS_SPECTRUM_BLACKBODY:
         return norm * rs_planck(s->temperature_k, lambda_nm);
     case RS_SPECTRUM_LINE:

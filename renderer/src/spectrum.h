@@ -121,6 +121,14 @@ double rs_luminance(rs_color c);
  * Negative components count as 0. */
 double rs_reflectance(rs_color c, double lambda_nm);
 
+/* The relative spectrum of an RGB EMITTER (before the D65 factor): linear
+ * in c, c.r s_R + c.g s_G + c.b s_B with Smits' red, green and blue
+ * spectra normalized to add up to exactly 1 at every wavelength (negative
+ * components count as 0).  Linear, so a renderer can undo the colour error
+ * of its own wavelength quadrature with one 3x3 matrix and reproduce every
+ * emitter's RGB exactly (integrator.c does). */
+double rs_emission_shape(rs_color c, double lambda_nm);
+
 /* 1/K, K = integral over 380-780 nm of D65(lambda) ȳ(lambda) dlambda
  * (exact for the interpolated tables: K = 10567.0315473943...). */
 double rs_spectral_normalization(void);
@@ -141,8 +149,8 @@ double rs_spectrum_norm(const rs_spectrum *s);
 
 /* The emitted spectral radiance at lambda_nm given norm =
  * rs_spectrum_norm(s):
- *   RGB:       norm * D65(lambda) * reflectance(rgb)(lambda), with the
- *              M > 1 rule above.  (1,1,1) -> Y = 1 over 380-780 nm.
+ *   RGB:       norm * D65(lambda) * rs_emission_shape(rgb, lambda).
+ *              (1,1,1) -> Y = 1 over 380-780 nm.
  *   BLACKBODY: norm * planck(T, lambda): integrates over 380-780 nm to
  *              Y = luminance(tint), chromaticity that of the black body.
  *   LINE:      0 (a delta; see rs_spectrum_line_xyz). */
