@@ -240,6 +240,10 @@ const char *rs_args_parse(rs_args *args, int argc, char **argv)
             options_done = 1;
             continue;
         }
+        if (strcmp(a, "--no-dispersion") == 0) {
+            args->no_dispersion = 1;
+            continue;
+        }
         if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
             args->quiet = 1;
             continue;

@@ -48,6 +48,9 @@ typedef struct rs_args {
     int threads;          /* 1..1024; 0 = every online processor (default) */
     double cutoff;        /* 0..1; < 0 = the scene's adc_bailout (default) */
     int quiet;            /* --quiet / -q */
+    int no_dispersion;    /* --no-dispersion: every glass becomes a constant,
+                             lossless index, its index at 587.56 nm (for
+                             comparisons with POV-Ray) */
     char out_default[RS_ARGS_PATH_MAX];
     char error[RS_ARGS_ERROR_MAX];
 } rs_args;

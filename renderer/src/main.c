@@ -58,6 +58,8 @@ static const char *const usage_text[] = {
 "  --threads N         worker threads, 1..1024 (default 0: every core)\n"
 "  --pfm FILE          also write linear float RGB (Portable FloatMap)\n"
 "  -q, --quiet         print nothing but errors\n"
+"  --no-dispersion     every glass becomes a constant lossless index, its\n"
+"                      index at 587.56 nm (to compare with POV-Ray)\n"
 "  -h, --help          this text\n"
 "  -V, --version       the version\n"
 "\n"
@@ -165,6 +167,12 @@ static int run(const rs_args *a)
         goto done;
     }
     if (rs_scene_prepare(&scene, msg, sizeof msg) != 0) {
+        say(NULL, msg);
+        status = EXIT_BAD;
+        goto done;
+    }
+    if (a->no_dispersion &&
+        rs_scene_freeze_glass(&scene, RS_LAMBDA_D_LINE, msg, sizeof msg) != 0) {
         say(NULL, msg);
         status = EXIT_BAD;
         goto done;

@@ -1,5 +1,6 @@
 /* scene.c -- the scene's lifetime: defaults, freeing, and creating the
  * lensprim lenses once parsing is done. */
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -101,6 +102,36 @@ int rs_scene_prepare(rs_scene *scene, char *msg, size_t msg_size)
                                   o->u.lens.glass_name, err.message);
         }
         if (lp_lens_create(&o->u.lens.desc, &o->lens, &err) != LP_OK) {
+            o->lens = NULL;
+            return prep_error(msg, msg_size, &o->loc, "lens: %s", err.message);
+        }
+    }
+    return 0;
+}
+
+int rs_scene_freeze_glass(rs_scene *scene, double lambda_nm, char *msg, size_t msg_size)
+{
+    lp_error err;
+
+    if (msg != NULL && msg_size > 0)
+        msg[0] = '\0';
+    if (scene == NULL)
+        return -1;
+    for (size_t i = 0; i < scene->n_objects; i++) {
+        rs_object *o = &scene->objects[i];
+        if (o->type != RS_OBJ_LENS || o->lens == NULL)
+            continue;
+        lp_lens_desc *d = &o->u.lens.desc;
+        double ng = lp_glass_index(&d->glass, lambda_nm);
+        double nm = lp_glass_index(&d->medium, lambda_nm);
+        if (!isfinite(ng) || !isfinite(nm))
+            return prep_error(msg, msg_size, &o->loc, "lens: no index at %g nm", lambda_nm);
+        lp_glass_init_constant(&d->glass, ng);
+        lp_glass_init_constant(&d->medium, nm);
+        o->u.lens.glass_name[0] = '\0';
+        lp_lens_destroy(o->lens);
+        o->lens = NULL;
+        if (lp_lens_create(d, &o->lens, &err) != LP_OK) {
             o->lens = NULL;
             return prep_error(msg, msg_size, &o->loc, "lens: %s", err.message);
         }

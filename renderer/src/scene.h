@@ -173,4 +173,13 @@ void rs_scene_free(rs_scene *scene);
  * Returns 0, or -1 with a message "file:line:col: ..." in msg. */
 int rs_scene_prepare(rs_scene *scene, char *msg, size_t msg_size);
 
+/* The helium d line (air wavelength), where catalogs quote n_d. */
+#define RS_LAMBDA_D_LINE 587.5618
+
+/* After rs_scene_prepare: replace every lens's glass and medium by
+ * constant, lossless indices, their indices at lambda_nm, and recreate the
+ * lenses.  For comparisons with renderers that have no dispersion or
+ * Beer-Lambert absorption (POV-Ray).  Returns 0, or -1 with a message. */
+int rs_scene_freeze_glass(rs_scene *scene, double lambda_nm, char *msg, size_t msg_size);
+
 #endif
