@@ -16,10 +16,11 @@
  * all others as intensities.
  *
  * Optical path outside lenses: a surface point X seen along unit d
- * starts its rays with the phase of a plane wave travelling along -d,
- * op = -d.X, and every segment of length t adds n t (the scene medium is
- * air, n = 1), so a ray's op is referred to the origin of the ray being
- * traced, as lp_backward_gather expects of a bundle.
+ * starts its rays with the phase of one plane wavefront per pixel,
+ * perpendicular to the camera ray through the point P where it first meets
+ * the scene (plane_op), and every segment of length t adds n t (the scene
+ * medium is air, n = 1), so a ray's op is referred to the origin of the
+ * ray being traced, as lp_backward_gather expects of a bundle.
  *
  * Levels follow POV-Ray: the camera ray is level 1; a query ray of depth
  * k from a lens hit at level L is level L + k; a ray that needs a level
@@ -76,6 +77,8 @@ struct rs_worker {
     const rs_integrator *it;
     frame *frames[RS_MAX_FRAMES];
     bundle pixel;
+    lp_vec3 ref;     /* the pixel's phase reference point (see plane_op) */
+    lp_vec3 ref_dir; /* and the direction of its camera ray */
 };
 
 /* Source ids: 0 ambient, 1 background, 2 + k light k, 2 + L + i object i. */
@@ -174,13 +177,16 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
             C[1][k] = rgb.g;
             C[2][k] = rgb.b;
         }
-        if (!invert3(C, it->correction)) {
-            snprintf(msg, msg_size, "internal error: singular colour quadrature");
-            free(it->coherent);
-            free(it->coherence);
-            free(it->light_norm);
-            free(it);
-            return -1;
+        if (n < 3 || !invert3(C, it->correction)) {
+            /* Fewer than three wavelengths cannot carry colour: render the
+             * luminance as grey, scaled so that white is exactly 1. */
+            double wy = 0.2126 * (C[0][0] + C[0][1] + C[0][2]) +
+                        0.7152 * (C[1][0] + C[1][1] + C[1][2]) +
+                        0.0722 * (C[2][0] + C[2][1] + C[2][2]);
+            for (int r = 0; r < 3; r++)
+                for (int c = 0; c < 3; c++)
+                    it->correction[r][c] =
+                        (c == 0 ? 0.2126 : c == 1 ? 0.7152 : 0.0722) / (wy > 0.0 ? wy : 1.0);
         }
     }
     for (size_t k = 0; k < scene->n_lights; k++)
@@ -464,6 +470,21 @@ static void shift_op(bundle *out, size_t from, double dop)
         out->r[i].op += dop;
 }
 
+/* The optical path a ray starts with where it leaves an emitter, referred
+ * to the origin o of the ray being traced: that of a plane wavefront
+ * perpendicular to the pixel's camera ray through the pixel's reference
+ * point P (where the camera ray first meets the scene), c.(o - P).  All
+ * rays of one pixel split near P, so they compare their optical paths from
+ * one common wavefront; the result does not depend on where the world
+ * origin is, and rays leaving one flat face (as in Newton's rings) get no
+ * spurious path difference from their slightly different directions. */
+static double plane_op(const rs_worker *w, lp_vec3 o, lp_vec3 d)
+{
+    (void)d;
+    const lp_vec3 c = w->ref_dir;
+    return c.x * (o.x - w->ref.x) + c.y * (o.y - w->ref.y) + c.z * (o.z - w->ref.z);
+}
+
 static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
                       int skip, int f, bundle *out)
 {
@@ -473,7 +494,7 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
     size_t start = out->n;
 
     if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
-        emit_ctx e = {out, d, -dot(d, o)};
+        emit_ctx e = {out, d, -plane_op(w, o, d)};
         double L = band_emission(b, sc->background);
         if (L != 0.0)
             emit_halves(&e, 1, L);
@@ -540,7 +561,7 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
         shift_op(out, start, h.t);
         return;
     }
-    emit_ctx e = {out, d, -dot(d, o)};
+    emit_ctx e = {out, d, -plane_op(w, o, d)};
     shade(it, b, &h, emit_halves, &e);
 }
 
@@ -583,7 +604,10 @@ static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
     const rs_integrator *it = w->it;
     if (it->opts.mode != RS_MODE_POLARIZED)
         return trace_scalar(w, b, o, d, 1, 1.0, -1, 0);
+    rs_hit h;
     w->pixel.n = 0;
+    w->ref = rs_scene_intersect(it->scene, o, d, 0.0, INFINITY, -1, &h) ? h.point : o;
+    w->ref_dir = d;
     trace_pol(w, b, o, d, 1, 1.0, -1, 0, &w->pixel);
     return bundle_power(it, &w->pixel, b->lambda);
 }

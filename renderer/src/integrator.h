@@ -1,7 +1,8 @@
 /* integrator.h -- Whitted-style backward tracing of a scene with lenses
  * as single primitives, in four light models (renderer-internal).
  *
- * A pixel's value is linear sRGB (D65).  Spectral modes sample
+ * A pixel's value is linear sRGB (D65).  Wavelengths are in standard air
+ * (as the CIE tables and glass catalogs give them).  Spectral modes sample
  * `wavelengths` wavelengths over 380-780 nm (the midpoints of equal bands:
  * noise-free, the same for every pixel) plus the line wavelengths of
  * monochromatic lights, weight them with the CIE 1931 2-degree observer to

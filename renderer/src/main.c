@@ -220,11 +220,8 @@ static int run(const rs_args *a)
         goto done;
     }
 
-    if (rs_png_write(a->out_png, &img, msg, sizeof msg) != 0) {
-        say(NULL, msg);
-        status = EXIT_RENDER;
-        goto done;
-    }
+    /* The PFM first: if it cannot be written, the PNG (the main output)
+     * is left as it was.  Each file is written atomically. */
     if (a->pfm) {
         if (rs_pfm_write(a->pfm, &img, msg, sizeof msg) != 0) {
             say(NULL, msg);
@@ -233,6 +230,11 @@ static int run(const rs_args *a)
         }
         if (!a->quiet)
             fprintf(stderr, "lensrender: wrote %s\n", a->pfm);
+    }
+    if (rs_png_write(a->out_png, &img, msg, sizeof msg) != 0) {
+        say(NULL, msg);
+        status = EXIT_RENDER;
+        goto done;
     }
     if (!a->quiet)
         fprintf(stderr,
