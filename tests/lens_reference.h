@@ -398,5 +398,10 @@ static inline lv3 random_surface_point(const ref_lens *L, int which)
         long double z = L->zf + u * (L->zb - L->zf), r = L->a1 + u * (L->a2 - L->a1);
         return L3(r * cosl(phi), r * sinl(phi), z);
     }
+    int back = which == 1;
+    long double a = back ? L->a2 : L->a1, r = sqrtl(urand()) * a;
+    long double z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
+    return L3(r * cosl(phi), r * sinl(phi), z);
+}
 
 #endif

@@ -45,11 +45,6 @@
 /* ------------------------------------------------------------------ */
 
 #include "lens_reference.h"
-    int back = which == 1;
-    long double a = back ? L->a2 : L->a1, r = sqrtl(urand()) * a;
-    long double z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
-    return L3(r * cosl(phi), r * sinl(phi), z);
-}
 
 /* ------------------------------------------------------------------ */
 /* optics written here: refraction, Fresnel amplitudes, Jones transport */

@@ -30,11 +30,6 @@
 /* ------------------------------------------------------------------ */
 
 #include "lens_reference.h"
-    int back = which == 1;
-    long double a = back ? L->a2 : L->a1, r = sqrtl(urand()) * a;
-    long double z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
-    return L3(r * cosl(phi), r * sinl(phi), z);
-}
 static inline lv3 lcross(lv3 a, lv3 b)
 {
     return L3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);

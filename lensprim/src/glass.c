@@ -25,9 +25,11 @@
 /* n^2 = 1 + sum B_k l^2 / (l^2 - C_k), coef = B1 B2 B3 C1 C2 C3. */
 static double sellmeier(const double *c, double l)
 {
-    double l2 = l * l;
-    double n2 = 1.0 + c[0] * l2 / (l2 - c[3]) + c[1] * l2 / (l2 - c[4])
-              + c[2] * l2 / (l2 - c[5]);
+    /* B l^2/(l^2 - C) written as B/(1 - C/l^2): no overflow of l^2 at
+     * absurdly long wavelengths, where n tends to sqrt(1 + B1 + B2 + B3) */
+    double m2 = 1.0 / (l * l);
+    double n2 = 1.0 + c[0] / (1.0 - c[3] * m2) + c[1] / (1.0 - c[4] * m2)
+              + c[2] / (1.0 - c[5] * m2);
     return sqrt(n2); /* NaN between resonances, where n2 < 0 */
 }
 
@@ -256,6 +258,11 @@ static lp_status check_table(const lp_glass *g, lp_error *err)
             return lp__fail(err, LP_ERROR_INVALID_GLASS,
                             "glass \"%s\": transmittance %g at %g nm is not in "
                             "(0, 1]", g->name, t, l);
+        if (!isfinite(log(t) / g->tau_thickness_mm))
+            return lp__fail(err, LP_ERROR_INVALID_GLASS,
+                            "glass \"%s\": transmittance %g at %g nm over %g mm "
+                            "gives an absorption coefficient that is not finite",
+                            g->name, t, l, g->tau_thickness_mm);
     }
     return LP_OK;
 }

@@ -29,10 +29,13 @@ static inline int v3_finite(lp_vec3 a) { return isfinite(a.x) && isfinite(a.y) &
 /* Unit vector along a; a zero or non-finite a gives (0,0,0). */
 static inline lp_vec3 v3_normalize(lp_vec3 a)
 {
-    double l = v3_len(a);
-    if (!(l > 0.0) || !isfinite(l))
+    /* Scale by the largest component first: exact for tiny (denormal) and
+     * huge vectors, whose squared length would underflow or overflow. */
+    double m = fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
+    if (!(m > 0.0) || !isfinite(m))
         return v3(0.0, 0.0, 0.0);
-    return v3_scale(a, 1.0 / l);
+    a = v3(a.x / m, a.y / m, a.z / m); /* not * (1/m): 1/m can overflow */
+    return v3_scale(a, 1.0 / v3_len(a));
 }
 /* Any unit vector perpendicular to the unit vector a (deterministic). */
 static inline lp_vec3 v3_any_perp(lp_vec3 a)
