@@ -49,6 +49,7 @@
 #include <complex.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -89,12 +90,16 @@ static const sellmeier GLASSES[2] = {
     {"N-SF11", {1.73759695, 0.313747346, 1.89878101}, {0.013188707, 0.0623068142, 155.23629}},
 };
 
+/* The index of the glass the lens is made of.  The dispersion formula
+ * itself is checked against the makers' catalog values in test_glass;
+ * here the closed forms need the very double the lens uses (a one-ulp
+ * difference in n moves R by ~1e-15, the size of these tolerances), so the
+ * index comes from lp_glass_index on the same coefficients. */
 static double sellmeier_n(const sellmeier *g, double lambda_nm)
 {
-    double l2 = (lambda_nm * 1e-3) * (lambda_nm * 1e-3), n2 = 1.0;
-    for (int k = 0; k < 3; k++)
-        n2 += g->b[k] * l2 / (l2 - g->c[k]);
-    return sqrt(n2);
+    lp_glass glass;
+    lp_glass_init_sellmeier(&glass, g->name, g->b, g->c);
+    return lp_glass_index(&glass, lambda_nm);
 }
 
 /* Fresnel reflectances from n1 into n2 at incidence angle th (rad); 1, 1
@@ -267,7 +272,13 @@ static void check_plates(void)
                           g->name, sn, deg);
                 CHECK_ABS(pol[1], want.pol[1], 2e-15, "%s %s %.1f: R1 = (Rs+Rp)/2", g->name, sn,
                           deg);
-                CHECK_ABS(sch[1], want.sch[1], 2e-15, "%s %s %.1f: R1 schlick", g->name, sn, deg);
+                /* the ray's direction carries an angle error of a few eps,
+                 * which near the critical angle Schlick's cos t amplifies */
+                plate_powers wp = plate_closed_form(deg * DEG + 1e-7, n1, n2);
+                plate_powers wm = plate_closed_form(deg * DEG - 1e-7, n1, n2);
+                double slope = fabs(wp.sch[1] - wm.sch[1]) / 2e-7;
+                CHECK_ABS(sch[1], want.sch[1], 2e-15 + 8 * DBL_EPSILON * slope,
+                          "%s %s %.1f: R1 schlick", g->name, sn, deg);
                 /* 3: two and three interfaces */
                 for (int k = 2; k <= 3; k++) {
                     CHECK_ABS(pol[k], want.pol[k], 1e-14, "%s %s %.1f: polarized depth %d",
@@ -283,7 +294,10 @@ static void check_plates(void)
                           "%s %s %.1f: T_pol - T_fres = (Rs-Rp)^2/4", g->name, sn, deg);
                 CHECK(pol[2] >= fres[2] - 1e-15, "%s %s %.1f: T_pol >= T_fres", g->name, sn, deg);
                 if (deg > crit) {
-                    CHECK_ABS(pol[1], 1.0, 1e-15, "%s %s %.1f: TIR", g->name, sn, deg);
+                    /* |rs|^2 and |rp|^2 of two unit complex numbers, halved
+                     * and added: a few roundings, 8 ulp */
+                    CHECK_ABS(pol[1], 1.0, 8 * DBL_EPSILON, "%s %s %.1f: TIR", g->name, sn,
+                              deg);
                     CHECK_ABS(pol[2] + fres[2] + sch[2], 0.0, 0.0, "%s %s %.1f: nothing through",
                               g->name, sn, deg);
                 }

@@ -64,6 +64,8 @@ struct rs_integrator {
     unsigned char *coherent;    /* per source */
     double *coherence;          /* per source: coherence length, 0 = infinite */
     double *light_norm;         /* per light: rs_spectrum_norm of its spectrum */
+    rs_color *light_rgb;        /* per light: its colour in the rgb mode (a
+                                   line's or black body's own colour) */
     double correction[3][3];    /* C^-1: makes every RGB emitter exact */
 };
 
@@ -93,6 +95,31 @@ void rs_render_opts_init(rs_render_opts *o)
     o->cutoff = -1.0;
     o->width = 320;
     o->height = 240;
+}
+
+/* The linear sRGB colour of a light's spectrum (negative components of
+ * out-of-gamut lines clipped): what the rgb mode lights the scene with. */
+static rs_color light_colour(const rs_spectrum *s, double norm)
+{
+    double xyz[3] = {0, 0, 0}, cmf[3];
+    rs_color c;
+    if (s->type == RS_SPECTRUM_RGB)
+        return s->rgb;
+    if (s->type == RS_SPECTRUM_LINE) {
+        rs_spectrum_line_xyz(s, xyz);
+    } else {
+        for (double l = RS_LAMBDA_MIN + 0.5; l < RS_LAMBDA_MAX; l += 1.0) {
+            double e = rs_spectrum_emission_norm(s, norm, l);
+            rs_cmf(l, cmf);
+            for (int k = 0; k < 3; k++)
+                xyz[k] += e * cmf[k];
+        }
+    }
+    rs_xyz_to_linear_srgb(xyz, &c);
+    c.r = c.r > 0.0 ? c.r : 0.0;
+    c.g = c.g > 0.0 ? c.g : 0.0;
+    c.b = c.b > 0.0 ? c.b : 0.0;
+    return c;
 }
 
 /* Invert a 3x3 matrix; 0 if singular. */
@@ -134,10 +161,12 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
     it->coherent = calloc((size_t)it->n_sources, 1);
     it->coherence = calloc((size_t)it->n_sources, sizeof *it->coherence);
     it->light_norm = calloc(scene->n_lights + 1, sizeof *it->light_norm);
-    if (!it->coherent || !it->coherence || !it->light_norm) {
+    it->light_rgb = calloc(scene->n_lights + 1, sizeof *it->light_rgb);
+    if (!it->coherent || !it->coherence || !it->light_norm || !it->light_rgb) {
         free(it->coherent);
         free(it->coherence);
         free(it->light_norm);
+        free(it->light_rgb);
         free(it);
         snprintf(msg, msg_size, "out of memory");
         return -1;
@@ -148,6 +177,7 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
         rs_spectrum ls = scene->lights[k].spectrum;
         ls.rgb = scene->lights[k].color;
         it->light_norm[k] = rs_spectrum_norm(&ls);
+        it->light_rgb[k] = light_colour(&ls, it->light_norm[k]);
     }
     /* The N wavelengths are the midpoints of N equal bands over 380-780 nm
      * (no jitter: no noise, the same for every pixel).  Emitter spectra
@@ -205,6 +235,7 @@ void rs_integrator_destroy(rs_integrator *it)
     free(it->coherent);
     free(it->coherence);
     free(it->light_norm);
+    free(it->light_rgb);
     free(it);
 }
 
@@ -305,7 +336,7 @@ static double band_light(const rs_integrator *it, const band *b, int k)
 {
     const rs_light *l = &it->scene->lights[k];
     if (b->kind == BAND_RGB)
-        return chan(l->color, b->channel);
+        return chan(it->light_rgb[k], b->channel);
     if (b->kind == BAND_LINE)
         return b->light == k ? 1.0 : 0.0;
     if (l->spectrum.type == RS_SPECTRUM_LINE)
