@@ -37,7 +37,9 @@
  * separated by spaces or tabs.  Numbers are parsed without the C locale,
  * so a program that set LC_NUMERIC to a decimal comma reads them right.
  * Glasses are parsed into a private list and added to the catalog only
- * when the whole text has been read without error. */
+ * when the whole text has been read without error.  Text longer than
+ * 64 MiB (a file is not read further) and a catalog that would hold more
+ * than 20,000 glasses are refused. */
 #include <float.h>
 #include <math.h>
 #include <stdint.h>
@@ -53,6 +55,13 @@
 #define WINDOW_LO_NM 380.0
 #define WINDOW_HI_NM 780.0
 #define THIN_TO (4 * LP_GLASS_TABLE_MAX)
+/* Longest AGF text read (real catalogs are well under 1 MiB; a file is not
+ * read past this, so /dev/zero or a runaway file cannot exhaust memory). */
+#define AGF_MAX_BYTES ((size_t)64 << 20)
+/* Most glasses a catalog may hold (real AGF catalogs have a few hundred;
+ * the catalog finds names by a linear search, so this also bounds the
+ * time a load and a lookup take). */
+#define AGF_MAX_GLASSES 20000
 
 typedef struct token {
     const char *s;
@@ -360,6 +369,10 @@ static lp_status finish_glass(parser *p)
     }
     set_formula(&p->cur, p->cd);
     build_table(p);
+    if (p->count >= AGF_MAX_GLASSES) {
+        snprintf(msg, sizeof msg, "more than %d glasses", AGF_MAX_GLASSES);
+        return parse_error(p, p->nm_line, msg, NULL);
+    }
     if (p->count == p->capacity) {
         size_t cap = p->capacity ? 2 * p->capacity : 32;
         lp_glass *list = realloc(p->list, cap * sizeof *list);
@@ -439,6 +452,8 @@ static lp_status read_ld(parser *p, const token *t, int nt)
         return s;
     if (!(lo == 0.0 && hi == 0.0) && !(lo >= 0.0 && lo < hi))
         return parse_error(p, p->line, "LD range is not 0 <= min < max", NULL);
+    if (!isfinite(hi * 1e3))
+        return parse_error(p, p->line, "LD wavelength out of range", &t[2]);
     p->cur.lambda_min_nm = lo * 1e3;
     p->cur.lambda_max_nm = hi * 1e3;
     return LP_OK;
@@ -457,8 +472,9 @@ static lp_status read_it(parser *p, const token *t, int nt)
         (s = number(p, &t[2], "IT transmittance", &x.tau)) != LP_OK ||
         (s = number(p, &t[3], "IT thickness", &x.thickness_mm)) != LP_OK)
         return s;
-    if (!(x.lambda_nm > 0.0))
-        return parse_error(p, p->line, "IT wavelength is not > 0", &t[1]);
+    if (!(x.lambda_nm > 0.0) || !isfinite(x.lambda_nm * 1e3))
+        return parse_error(p, p->line, "IT wavelength is not > 0 (or out of range)",
+                           &t[1]);
     if (!(x.tau >= 0.0 && x.tau <= 1.0))
         return parse_error(p, p->line, "IT transmittance is not in [0, 1]",
                            &t[2]);
@@ -629,6 +645,10 @@ static lp_status load(lp_catalog *catalog, const unsigned char *bytes,
     p.source = source;
     p.err = err;
 
+    if (n > AGF_MAX_BYTES)
+        return lp__fail(err, LP_ERROR_PARSE, "%s: larger than %u MiB",
+                        source, (unsigned)(AGF_MAX_BYTES >> 20));
+
     if (n >= 2 && bytes[0] == 0xFF && bytes[1] == 0xFE)
         s = utf16_to_utf8(&p, bytes + 2, n - 2, 0, &decoded, &len);
     else if (n >= 2 && bytes[0] == 0xFE && bytes[1] == 0xFF)
@@ -651,6 +671,11 @@ static lp_status load(lp_catalog *catalog, const unsigned char *bytes,
                      "mark)", source);
     else
         s = read_text(&p, text, len);
+    if (s == LP_OK && (lp_catalog_count(catalog) > AGF_MAX_GLASSES ||
+                       p.count > AGF_MAX_GLASSES - lp_catalog_count(catalog)))
+        s = lp__fail(err, LP_ERROR_PARSE,
+                     "%s: the catalog would hold more than %d glasses", source,
+                     AGF_MAX_GLASSES);
     if (s == LP_OK)
         s = lp__catalog_add(catalog, p.list, p.count, err);
     if (s == LP_OK)
@@ -694,7 +719,10 @@ lp_status lp_catalog_load_agf(lp_catalog *catalog, const char *path,
         size_t got;
         if (len == cap) {
             size_t ncap = cap ? 2 * cap : 65536;
-            unsigned char *nbuf = realloc(buf, ncap);
+            unsigned char *nbuf;
+            if (ncap > AGF_MAX_BYTES + 1)
+                ncap = AGF_MAX_BYTES + 1; /* one byte more tells "too long" */
+            nbuf = realloc(buf, ncap);
             if (!nbuf) {
                 free(buf);
                 fclose(f);
@@ -706,8 +734,8 @@ lp_status lp_catalog_load_agf(lp_catalog *catalog, const char *path,
         }
         got = fread(buf + len, 1, cap - len, f);
         len += got;
-        if (got == 0)
-            break;
+        if (got == 0 || len > AGF_MAX_BYTES)
+            break; /* len > MAX: too long, refused by load() */
     }
     if (ferror(f)) {
         free(buf);

@@ -18,7 +18,13 @@
 #include "parser.h"
 
 #define MAX_DEPTH 64
-#define DEFAULT_MAX_OBJECTS ((size_t)10000000)
+/* An rs_object is about 2.5 kB (a lens description holds two glasses), so
+ * 100,000 objects take about 250 MB; a scene asking for more is refused
+ * rather than left to exhaust memory.  (The renderer tests every object
+ * on every ray, so such scenes are far beyond what it can render anyway.) */
+#define DEFAULT_MAX_OBJECTS ((size_t)100000)
+/* Longest scene text read (a file stops being read past this). */
+#define MAX_SOURCE_BYTES ((size_t)64 << 20)
 #define DEFAULT_WIDTH 640
 #define DEFAULT_HEIGHT 480
 #define PI_VALUE 3.14159265358979323846
@@ -297,6 +303,30 @@ static void sym_free(parser *p)
     p->sym_cap = p->sym_count = 0;
 }
 
+/* |v| without overflow or underflow in the squares (0 for a zero vector,
+ * not finite when a component is not). */
+static double vec_length(lp_vec3 v)
+{
+    double m = fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z)));
+    double x, y, z;
+    if (!(m > 0.0) || !isfinite(m))
+        return m;
+    x = v.x / m, y = v.y / m, z = v.z / m;
+    return m * sqrt(x * x + y * y + z * z);
+}
+
+/* v / |v| into *out; 0 (and *out untouched) when v is zero or not finite. */
+static int normalize(lp_vec3 v, lp_vec3 *out)
+{
+    double m = fmax(fabs(v.x), fmax(fabs(v.y), fabs(v.z))), l;
+    if (!(m > 0.0) || !isfinite(m))
+        return 0;
+    v = (lp_vec3){ v.x / m, v.y / m, v.z / m };
+    l = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    *out = (lp_vec3){ v.x / l, v.y / l, v.z / l };
+    return 1;
+}
+
 /* ------------------------------------------------------------------ */
 /* Expressions                                                         */
 /* ------------------------------------------------------------------ */
@@ -509,15 +539,16 @@ static int parse_function(parser *p, const fn_def *fn, val *out)
         r = fmod(a[0].v[0], a[1].v[0]);
         break;
     case FN_VLENGTH:
-        r = sqrt(a[0].v[0] * a[0].v[0] + a[0].v[1] * a[0].v[1] + a[0].v[2] * a[0].v[2]);
+        r = vec_length((lp_vec3){ a[0].v[0], a[0].v[1], a[0].v[2] });
         break;
     case FN_VNORMALIZE: {
-        double l = sqrt(a[0].v[0] * a[0].v[0] + a[0].v[1] * a[0].v[1] + a[0].v[2] * a[0].v[2]);
-        if (!(l > 0.0))
+        lp_vec3 u;
+        if (!normalize((lp_vec3){ a[0].v[0], a[0].v[1], a[0].v[2] }, &u))
             return error_at(p, name.line, name.column, "vnormalize() of a zero vector");
         out->vec = 1;
-        for (int i = 0; i < 3; i++)
-            out->v[i] = a[0].v[i] / l;
+        out->v[0] = u.x;
+        out->v[1] = u.y;
+        out->v[2] = u.z;
         break;
     }
     case FN_VDOT:
@@ -1120,20 +1151,13 @@ static int vec_finite(lp_vec3 v)
     return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
 }
 
-static lp_vec3 normalized(lp_vec3 v)
-{
-    double l = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
-    lp_vec3 r = { v.x / l, v.y / l, v.z / l };
-    return r;
-}
-
 static int parse_plane(parser *p, rs_object *o)
 {
     if (open_block(p, "plane") != 0)
         return -1;
     if (parse_nonzero_vector(p, "the plane normal", &o->u.plane.normal) != 0)
         return -1;
-    o->u.plane.normal = normalized(o->u.plane.normal);
+    normalize(o->u.plane.normal, &o->u.plane.normal); /* non-zero, finite */
     skip_comma(p);
     if (parse_float(p, "the plane distance", &o->u.plane.distance) != 0)
         return -1;
@@ -1175,7 +1199,7 @@ static int parse_disc(parser *p, rs_object *o)
     skip_comma(p);
     if (parse_nonzero_vector(p, "the disc normal", &o->u.disc.normal) != 0)
         return -1;
-    o->u.disc.normal = normalized(o->u.disc.normal);
+    normalize(o->u.disc.normal, &o->u.disc.normal); /* non-zero, finite */
     skip_comma(p);
     start = *peek(p);
     if (parse_float(p, "the disc radius", &o->u.disc.radius) != 0)
@@ -1210,8 +1234,7 @@ static int check_uniform(parser *p, const rs_token *kw, lp_vec3 s, const char *o
 /* A similarity transform's scale factor. */
 static double xf_scale_factor(const rs_transform *xf)
 {
-    lp_vec3 d = rs_xf_dir(xf, (lp_vec3){ 0.0, 0.0, 1.0 });
-    return sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+    return vec_length(rs_xf_dir(xf, (lp_vec3){ 0.0, 0.0, 1.0 }));
 }
 
 /* A lens radius: a float, or inf / -inf / +inf (flat). */
@@ -1385,6 +1408,9 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
         !vec_finite(d->position) || !vec_finite(d->axis))
         return error_at(p, kw->line, kw->column,
                         "lens: a value is not finite after the transforms");
+    if ((r1 != 0.0 && d->radius1 == 0.0) || (r2 != 0.0 && d->radius2 == 0.0))
+        return error_at(p, kw->line, kw->column,
+                        "lens: a radius underflows to 0 (flat) after the transforms");
     return 0;
 }
 
@@ -1392,7 +1418,7 @@ static int parse_polarizer(parser *p, rs_object *o, const rs_token *kw)
 {
     rs_transform xf;
     lp_vec3 c = { 0.0, 0.0, 0.0 }, n = { 0.0, 0.0, 0.0 }, a = { 0.0, 0.0, 0.0 };
-    double r = 0.0, k, dot, l;
+    double r = 0.0, k, dot;
     int have_n = 0, have_r = 0, have_a = 0;
     rs_token axis_tok = *kw;
 
@@ -1442,21 +1468,25 @@ static int parse_polarizer(parser *p, rs_object *o, const rs_token *kw)
                         !have_n ? "normal" : !have_r ? "radius" : "axis");
     /* Fold the transforms; keep the axis in the disc's plane. */
     k = xf_scale_factor(&xf);
-    n = normalized(rs_xf_dir(&xf, n));
-    a = rs_xf_dir(&xf, a);
-    l = sqrt(a.x * a.x + a.y * a.y + a.z * a.z);
+    if (!normalize(rs_xf_dir(&xf, n), &n) || !normalize(rs_xf_dir(&xf, a), &a))
+        return error_at(p, kw->line, kw->column,
+                        "polarizer: the normal or the axis is not finite (or vanishes) after "
+                        "the transforms");
     dot = a.x * n.x + a.y * n.y + a.z * n.z;
     a = (lp_vec3){ a.x - dot * n.x, a.y - dot * n.y, a.z - dot * n.z };
-    if (sqrt(a.x * a.x + a.y * a.y + a.z * a.z) <= 1e-9 * l)
+    if (!(vec_length(a) > 1e-9) || !normalize(a, &a))
         return error_at(p, axis_tok.line, axis_tok.column,
                         "the polarizer axis must not be parallel to its normal");
     o->u.polarizer.center = rs_xf_point(&xf, c);
     o->u.polarizer.normal = n;
-    o->u.polarizer.axis = normalized(a);
+    o->u.polarizer.axis = a;
     o->u.polarizer.radius = r * k;
     if (!vec_finite(o->u.polarizer.center) || !isfinite(o->u.polarizer.radius))
         return error_at(p, kw->line, kw->column,
                         "polarizer: a value is not finite after the transforms");
+    if (!(o->u.polarizer.radius > 0.0))
+        return error_at(p, kw->line, kw->column,
+                        "polarizer: the radius underflows to 0 after the transforms");
     return close_block(p, "polarizer");
 }
 
@@ -1689,8 +1719,10 @@ static int parse_light(parser *p)
     if (!vec_finite(l.position))
         return error_at(p, kw.line, kw.column,
                         "light_source: the position is not finite after the transforms");
-    if (l.polarized)
-        l.polarization = normalized(rs_xf_dir(&xf, l.polarization));
+    if (l.polarized && !normalize(rs_xf_dir(&xf, l.polarization), &l.polarization))
+        return error_at(p, kw.line, kw.column,
+                        "light_source: the polarization is not finite (or vanishes) after "
+                        "the transforms");
     l.spectrum.rgb = l.color;
     return push_light(p, &l, &kw);
 }
@@ -1884,6 +1916,11 @@ static int parse_buffer(const char *text, size_t len, const char *name,
     parser p;
     int rc;
 
+    if (len > MAX_SOURCE_BYTES) {
+        set_msg(msg, msg_size, "%s:1:1: the scene is larger than %zu MiB", name,
+                MAX_SOURCE_BYTES >> 20);
+        return -1;
+    }
     memset(&p, 0, sizeof p);
     p.msg = msg;
     p.msg_size = msg_size;
@@ -1944,7 +1981,10 @@ int rs_parse_file(const char *path, const rs_parse_opts *opts, rs_scene *scene, 
         size_t got;
         if (len == cap) {
             size_t ncap = cap ? cap * 2 : 65536;
-            char *nb = realloc(buf, ncap);
+            char *nb;
+            if (ncap > MAX_SOURCE_BYTES + 1)
+                ncap = MAX_SOURCE_BYTES + 1; /* one byte more tells "too long" */
+            nb = realloc(buf, ncap);
             if (nb == NULL) {
                 free(buf);
                 fclose(f);
@@ -1956,8 +1996,8 @@ int rs_parse_file(const char *path, const rs_parse_opts *opts, rs_scene *scene, 
         }
         got = fread(buf + len, 1, cap - len, f);
         len += got;
-        if (got == 0)
-            break;
+        if (got == 0 || len > MAX_SOURCE_BYTES)
+            break; /* len > MAX: too long (/dev/zero, ...), refused below */
     }
     if (ferror(f)) {
         set_msg(msg, msg_size, "%s: cannot read: %s", path, strerror(errno));

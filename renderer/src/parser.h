@@ -71,7 +71,7 @@
 typedef struct rs_parse_opts {
     int image_width;     /* the value of image_width; <= 0: 640 */
     int image_height;    /* the value of image_height; <= 0: 480 */
-    size_t max_objects;  /* objects (and lights) allowed; 0: 10,000,000 */
+    size_t max_objects;  /* objects (and lights) allowed; 0: 100,000 */
 } rs_parse_opts;
 
 /* All zero: the defaults above. */
