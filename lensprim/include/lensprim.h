@@ -93,7 +93,7 @@ typedef enum lp_status {
     LP_ERROR_INVALID_LENS,     /* a lens shape that cannot exist */
     LP_ERROR_INVALID_GLASS,    /* a glass description that cannot be used */
     LP_ERROR_UNKNOWN_GLASS,    /* no glass of that name in the catalog */
-    LP_ERROR_UNSUPPORTED,      /* e.g. an AGF dispersion formula not implemented */
+    LP_ERROR_UNSUPPORTED,      /* e.g. an AGF dispersion formula lensprim cannot evaluate */
     LP_ERROR_PARSE,            /* malformed catalog text */
     LP_ERROR_IO,               /* a file could not be read */
     LP_ERROR_NO_MEMORY,
