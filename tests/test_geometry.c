@@ -27,250 +27,26 @@
 /* small helpers                                                       */
 /* ------------------------------------------------------------------ */
 
-static uint64_t rng_state = 0x1234abcd5678ef01ULL;
-static uint64_t sm64(void)
-{
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ULL);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-    return z ^ (z >> 31);
-}
-static double urand(void) { return (double)(sm64() >> 11) * 0x1.0p-53; }
-static double urange(double a, double b) { return a + (b - a) * urand(); }
-
-static lp_vec3 V(double x, double y, double z) { lp_vec3 v = {x, y, z}; return v; }
-static lp_vec3 vadd(lp_vec3 a, lp_vec3 b) { return V(a.x + b.x, a.y + b.y, a.z + b.z); }
-static inline lp_vec3 vsub(lp_vec3 a, lp_vec3 b) { return V(a.x - b.x, a.y - b.y, a.z - b.z); }
-static lp_vec3 vscale(lp_vec3 a, double s) { return V(a.x * s, a.y * s, a.z * s); }
-static double vdot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static lp_vec3 vcross(lp_vec3 a, lp_vec3 b)
-{
-    return V(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
-static double vlen(lp_vec3 a) { return sqrt(vdot(a, a)); }
-static lp_vec3 vnorm(lp_vec3 a) { return vscale(a, 1.0 / vlen(a)); }
-static int vfinite(lp_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
-
-static lp_vec3 rand_unit(void)
-{
-    for (;;) {
-        lp_vec3 v = V(urange(-1, 1), urange(-1, 1), urange(-1, 1));
-        double l = vlen(v);
-        if (l > 0.1 && l <= 1.0)
-            return vscale(v, 1.0 / l);
-    }
-}
-
-typedef struct { long double x, y, z; } lv3;
-static lv3 L3(long double x, long double y, long double z) { lv3 v = {x, y, z}; return v; }
-static lv3 ladd(lv3 a, lv3 b) { return L3(a.x + b.x, a.y + b.y, a.z + b.z); }
-static lv3 lsub(lv3 a, lv3 b) { return L3(a.x - b.x, a.y - b.y, a.z - b.z); }
-static lv3 lscale(lv3 a, long double s) { return L3(a.x * s, a.y * s, a.z * s); }
-static long double ldot(lv3 a, lv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static long double llen(lv3 a) { return sqrtl(ldot(a, a)); }
-static lv3 lnorm(lv3 a) { return lscale(a, 1.0L / llen(a)); }
-static lv3 lfrom(lp_vec3 a) { return L3(a.x, a.y, a.z); }
-static lp_vec3 lto(lv3 a) { return V((double)a.x, (double)a.y, (double)a.z); }
+#include "lens_reference.h"
 
 /* A placement: world = P + e1*x + e2*y + A*z (A = the lens axis). */
-typedef struct { lp_vec3 P, e1, e2, A; } frame;
 
-static frame frame_make(lp_vec3 P, lp_vec3 A)
-{
-    frame f;
-    f.P = P;
-    f.A = vnorm(A);
-    lp_vec3 h = fabs(f.A.x) < 0.6 ? V(1, 0, 0) : (fabs(f.A.y) < 0.6 ? V(0, 1, 0) : V(0, 0, 1));
-    f.e1 = vnorm(vcross(f.A, h));
-    f.e2 = vcross(f.A, f.e1);
-    return f;
-}
-static frame frame_identity(void) { return frame_make(V(0, 0, 0), V(0, 0, 1)); }
 /* local -> world, in long double */
-static lv3 fw_point(const frame *f, lv3 p)
-{
-    return L3((long double)f->P.x + f->e1.x * p.x + f->e2.x * p.y + f->A.x * p.z,
-              (long double)f->P.y + f->e1.y * p.x + f->e2.y * p.y + f->A.y * p.z,
-              (long double)f->P.z + f->e1.z * p.x + f->e2.z * p.y + f->A.z * p.z);
-}
-static lv3 fw_dir(const frame *f, lv3 d)
-{
-    return L3(f->e1.x * d.x + f->e2.x * d.y + f->A.x * d.z,
-              f->e1.y * d.x + f->e2.y * d.y + f->A.y * d.z,
-              f->e1.z * d.x + f->e2.z * d.y + f->A.z * d.z);
-}
 /* world -> local, in long double */
-static lv3 fl_point(const frame *f, lp_vec3 w)
-{
-    lv3 d = L3((long double)w.x - f->P.x, (long double)w.y - f->P.y, (long double)w.z - f->P.z);
-    return L3(d.x * f->e1.x + d.y * f->e1.y + d.z * f->e1.z,
-              d.x * f->e2.x + d.y * f->e2.y + d.z * f->e2.z,
-              d.x * f->A.x + d.y * f->A.y + d.z * f->A.z);
-}
-static lv3 fl_dir(const frame *f, lp_vec3 w)
-{
-    lv3 d = lfrom(w);
-    return L3(d.x * f->e1.x + d.y * f->e1.y + d.z * f->e1.z,
-              d.x * f->e2.x + d.y * f->e2.y + d.z * f->e2.z,
-              d.x * f->A.x + d.y * f->A.y + d.z * f->A.z);
-}
-
-static int has_word(const char *msg, const char *word)
-{
-    size_t n = strlen(word);
-    for (const char *p = msg; *p; p++) {
-        size_t i = 0;
-        while (i < n && p[i] && (p[i] | 0x20) == (word[i] | 0x20))
-            i++;
-        if (i == n)
-            return 1;
-    }
-    return 0;
-}
 
 /* ------------------------------------------------------------------ */
 /* reference lens geometry, long double, local frame                   */
 /* ------------------------------------------------------------------ */
 
-typedef struct {
-    long double c1, c2, t, a1, a2, zf, zb, k;
-    int rim;
-    double size;
-} ref_lens;
-
-static long double curv(double R) { return (R == 0.0 || isinf(R)) ? 0.0L : 1.0L / (long double)R; }
 /* sag(h) = R - sign(R) sqrt(R^2 - h^2), written without cancellation:
  * c h^2 / (1 + sqrt(1 - c^2 h^2)), c = 1/R (0 for flat). */
-static long double rsag(long double c, long double h)
-{
-    return c * h * h / (1.0L + sqrtl(1.0L - c * c * h * h));
-}
-
-static void ref_init(ref_lens *L, double R1, double R2, double t, double D, double D2)
-{
-    L->c1 = curv(R1);
-    L->c2 = curv(R2);
-    L->t = t;
-    L->a1 = D / 2;
-    L->a2 = (D2 > 0 ? D2 : D) / 2;
-    L->zf = rsag(L->c1, L->a1);
-    L->zb = t + rsag(L->c2, L->a2);
-    double zmin = (double)fminl(0.0L, L->zf), zmax = (double)fmaxl(t, L->zb);
-    L->size = fmax(fmax(D, D2), zmax - zmin);
-    L->rim = (L->zb - L->zf) > 1e-12L * L->size;
-    L->k = L->rim ? (L->a2 - L->a1) / (L->zb - L->zf) : 0.0L;
-}
-
-typedef struct {
-    long double s;
-    lv3 p, n;
-    int surf;
-} ref_hit;
 
 /* roots of A s^2 + 2 B s + C = 0 (stable form) */
-static int quad_roots(long double A, long double B, long double C, long double r[2])
-{
-    if (A == 0.0L) {
-        if (B == 0.0L)
-            return 0;
-        r[0] = -C / (2.0L * B);
-        return 1;
-    }
-    long double disc = B * B - A * C;
-    if (disc < 0.0L)
-        return 0;
-    long double q = -(B + copysignl(sqrtl(disc), B));
-    if (q == 0.0L) {
-        r[0] = 0.0L;
-        return 1;
-    }
-    r[0] = q / A;
-    r[1] = C / q;
-    return 2;
-}
-
-static void consider(ref_hit *best, long double s, lv3 p, lv3 n, int surf)
-{
-    if (best->surf < 0 || s < best->s) {
-        best->s = s;
-        best->p = p;
-        best->n = n;
-        best->surf = surf;
-    }
-}
 
 /* Nearest surface hit of O + s d, s > smin (d unit). surf -1: none. */
-static ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, long double smin)
-{
-    ref_hit best;
-    best.surf = -1;
-    best.s = 0;
-    for (int side = 0; side < 2; side++) {
-        long double c = side ? L->c2 : L->c1, z0 = side ? L->t : 0.0L, a = side ? L->a2 : L->a1;
-        long double Z = O.z - z0;
-        long double A = c, B = c * (O.x * d.x + O.y * d.y + Z * d.z) - d.z;
-        long double C = c * (O.x * O.x + O.y * O.y + Z * Z) - 2.0L * Z;
-        long double r[2];
-        int nr = quad_roots(A, B, C, r);
-        for (int i = 0; i < nr; i++) {
-            if (!(r[i] > smin))
-                continue;
-            lv3 p = ladd(O, lscale(d, r[i]));
-            if (p.x * p.x + p.y * p.y > a * a)
-                continue;
-            if (c * (p.z - z0) >= 1.0L)
-                continue;
-            /* outward normal: front +grad G1, back -grad G2 */
-            lv3 g = L3(c * p.x, c * p.y, c * (p.z - z0) - 1.0L);
-            lv3 n = lnorm(side ? lscale(g, -1.0L) : g);
-            consider(&best, r[i], p, n, side ? LP_SURFACE_BACK : LP_SURFACE_FRONT);
-        }
-    }
-    if (L->rim) {
-        long double R0 = L->a1 + L->k * (O.z - L->zf);
-        long double A = d.x * d.x + d.y * d.y - L->k * L->k * d.z * d.z;
-        long double B = O.x * d.x + O.y * d.y - R0 * L->k * d.z;
-        long double C = O.x * O.x + O.y * O.y - R0 * R0;
-        long double r[2];
-        int nr = quad_roots(A, B, C, r);
-        for (int i = 0; i < nr; i++) {
-            if (!(r[i] > smin))
-                continue;
-            lv3 p = ladd(O, lscale(d, r[i]));
-            if (p.z < L->zf || p.z > L->zb)
-                continue;
-            long double rr = L->a1 + L->k * (p.z - L->zf);
-            lv3 n = lnorm(L3(p.x, p.y, -rr * L->k));
-            consider(&best, r[i], p, n, LP_SURFACE_RIM);
-        }
-    }
-    return best;
-}
 
 /* Inside test with a margin (a lower bound-ish of the distance to the
  * boundary, vertical for the caps). */
-static int ref_inside(const ref_lens *L, lv3 p, long double *margin)
-{
-    long double r = sqrtl(p.x * p.x + p.y * p.y);
-    long double rmax = fmaxl(L->a1, L->a2);
-    if (r >= rmax) {
-        *margin = r - rmax;
-        return 0;
-    }
-    long double lower, upper;
-    if (r <= L->a1)
-        lower = rsag(L->c1, r);
-    else
-        lower = L->zf + (r - L->a1) / L->k; /* cone, a2 > a1 */
-    if (r <= L->a2)
-        upper = L->t + rsag(L->c2, r);
-    else
-        upper = L->zf + (r - L->a1) / L->k; /* cone, a1 > a2 */
-    long double m = fminl(fabsl(p.z - lower), fabsl(p.z - upper));
-    m = fminl(m, rmax - r);
-    *margin = m;
-    return p.z > lower && p.z < upper;
-}
 
 /* ------------------------------------------------------------------ */
 /* lens construction                                                   */
