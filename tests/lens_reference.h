@@ -404,4 +404,24 @@ static inline lv3 random_surface_point(const ref_lens *L, int which)
     return L3(r * cosl(phi), r * sinl(phi), z);
 }
 
+/* Reflection and refraction of long-double directions. */
+static inline lv3 lcross(lv3 a, lv3 b)
+{
+    return L3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+
+static inline lv3 lreflect(lv3 d, lv3 n) { return ladd(d, lscale(n, -2 * ldot(d, n))); }
+
+static inline int lrefract(lv3 d, lv3 n, long double n1, long double n2, lv3 *out)
+{
+    lv3 m = ldot(d, n) < 0 ? n : lscale(n, -1); /* toward the incident side */
+    long double ci = -ldot(d, m), eta = n1 / n2;
+    long double st2 = eta * eta * (1 - ci) * (1 + ci);
+    if (st2 >= 1)
+        return 0;
+    long double ct = sqrtl(1 - st2);
+    *out = lnorm(ladd(lscale(d, eta), lscale(m, eta * ci - ct)));
+    return 1;
+}
+
 #endif

@@ -30,25 +30,9 @@
 /* ------------------------------------------------------------------ */
 
 #include "lens_reference.h"
-static inline lv3 lcross(lv3 a, lv3 b)
-{
-    return L3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
-static inline lv3 lreflect(lv3 d, lv3 n) { return ladd(d, lscale(n, -2 * ldot(d, n))); }
 
 /* Snell: d hits a surface with (either-sided) normal n from index n1 into
  * n2; 0 under TIR. */
-static inline int lrefract(lv3 d, lv3 n, long double n1, long double n2, lv3 *out)
-{
-    lv3 m = ldot(d, n) < 0 ? n : lscale(n, -1); /* toward the incident side */
-    long double ci = -ldot(d, m), eta = n1 / n2;
-    long double st2 = eta * eta * (1 - ci) * (1 + ci);
-    if (st2 >= 1)
-        return 0;
-    long double ct = sqrtl(1 - st2);
-    *out = lnorm(ladd(lscale(d, eta), lscale(m, eta * ci - ct)));
-    return 1;
-}
 
 #define MAXN 24
 typedef struct {
@@ -122,7 +106,6 @@ static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O
         dir = next;
     }
 }
-
 
 /* ------------------------------------------------------------------ */
 

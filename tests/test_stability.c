@@ -160,10 +160,6 @@ static LD cv_dist(cv a, cv b)
     long double complex dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
     return sqrtl(creall(dx * conjl(dx) + dy * conjl(dy) + dz * conjl(dz)));
 }
-static lv3 lcross(lv3 a, lv3 b)
-{
-    return L3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
 
 /* The field of one ray, sqrt(I) vp exp(i Phi); with_op 0 leaves the
  * propagation phase 2 pi op/lambda out. */
