@@ -13,7 +13,8 @@
  *   - nesting 10^5 deep (parentheses, vectors, calls, blocks, comments,
  *     unary signs): a clean error or a clean parse, no stack overflow;
  *   - 10^6 objects: refused at the object limit (100,000 by default), in a
- *     child process whose peak memory (getrusage) is checked and printed;
+ *     separate program (tests/tools/parse_many) whose own peak memory is
+ *     measured (tests/tools/measure_child), checked and printed;
  *   - every prefix of every .scene file in scenes/ (truncation at each byte),
  *     and prefixes followed by junk;
  *   - binary junk (random bytes with NULs, from files) and a file larger
@@ -24,13 +25,13 @@
  *     small), and a render whose PNG write fails half-way (RLIMIT_FSIZE)
  *     leaves the previous good PNG byte-for-byte intact and no temporary
  *     file behind. */
-#define _DEFAULT_SOURCE /* wait4 */
 #define _POSIX_C_SOURCE 200809L
 
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
+#include <poll.h>
 #include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -72,6 +73,8 @@
 #endif
 
 static const char *const LENSRENDER = LP_BIN_DIR "/lensrender";
+static const char *const MEASURE_CHILD = LP_BIN_DIR "/measure_child";
+static const char *const PARSE_MANY = LP_BIN_DIR "/parse_many";
 static const char *const REGRESSIONS = LP_SOURCE_DIR "/tests/regressions/scene";
 static const char *const SCENES = LP_SOURCE_DIR "/scenes";
 
@@ -519,68 +522,170 @@ static void test_nesting(void)
     }
 }
 
-/* ---- 10^6 objects ------------------------------------------------------- */
+/* ---- running a program with its peak memory measured ------------------ */
 
-/* Parse `count` copies of `item` in a child; returns the child's peak RSS
- * in KiB (-1 on failure) and the message / object count through a pipe. */
-static long parse_many_in_child(const char *item, long count, size_t max_objects, char *msg,
-                                size_t msg_size, long *objects, double *seconds)
+typedef struct run_result {
+    int status;       /* exit status, 128 + signal, or -1 */
+    long peak_kb;     /* the program's own peak RSS, KiB (-1: unknown) */
+    double seconds;
+    char out[2048];   /* stdout (start) */
+    char err[2048];   /* stderr (start) */
+} run_result;
+
+/* Append what fd has now to buf (NUL-terminated, the start kept); returns 0
+ * at end of file. */
+static int drain(int fd, char *buf, size_t size)
 {
-    int fds[2];
+    char chunk[4096];
+    ssize_t n = read(fd, chunk, sizeof chunk);
+    if (n < 0)
+        return errno == EINTR;
+    size_t len = strlen(buf);
+    for (ssize_t i = 0; i < n && len + 1 < size; i++)
+        buf[len++] = chunk[i];
+    buf[len] = '\0';
+    return n > 0;
+}
+
+/* Run argv (argv[0] the program's path) through measure_child, which
+ * reports the program's own peak RSS (see tests/tools/measure_child.c: a
+ * child forked from this process would count this process's memory, and
+ * under valgrind or ASan that is the tool's).  fsize_limit > 0 sets
+ * RLIMIT_FSIZE, with SIGXFSZ ignored, so writes fail with EFBIG.  stdout
+ * and stderr are captured. */
+static run_result run_measured(const char *const *argv, long fsize_limit)
+{
+    run_result r;
+    const char *cmd[40];
+    char fdarg[16];
+    int out[2], err[2], rep[2], st, n = 0;
     pid_t pid;
-    int st;
-    struct rusage ru;
     double t0 = now_s();
 
-    if (pipe(fds) != 0)
-        return -1;
+    memset(&r, 0, sizeof r);
+    r.status = -1;
+    r.peak_kb = -1;
+    if (pipe(out) != 0)
+        return r;
+    if (pipe(err) != 0) {
+        close(out[0]);
+        close(out[1]);
+        return r;
+    }
+    if (pipe(rep) != 0) {
+        close(out[0]);
+        close(out[1]);
+        close(err[0]);
+        close(err[1]);
+        return r;
+    }
+    snprintf(fdarg, sizeof fdarg, "%d", rep[1]);
+    cmd[n++] = MEASURE_CHILD;
+    cmd[n++] = fdarg;
+    for (int i = 0; argv[i] && n < 39; i++)
+        cmd[n++] = argv[i];
+    cmd[n] = NULL;
     fflush(stdout);
     fflush(stderr);
     pid = fork();
-    if (pid < 0)
-        return -1;
     if (pid == 0) {
-        size_t il = strlen(item);
-        char *text = malloc(il * (size_t)count + 1), m[512];
-        rs_scene scene;
-        rs_parse_opts opts;
-        long n;
-        close(fds[0]);
-        if (!text)
-            _exit(3);
-        for (long i = 0; i < count; i++)
-            memcpy(text + il * (size_t)i, item, il);
-        text[il * (size_t)count] = '\0';
-        rs_parse_opts_init(&opts);
-        opts.max_objects = max_objects;
-        rs_scene_init(&scene);
-        if (rs_parse_string(text, "many.scene", &opts, &scene, m, sizeof m) == 0)
-            snprintf(m, sizeof m, "ok");
-        n = (long)(scene.n_objects + scene.n_lights);
-        if (write(fds[1], &n, sizeof n) != (ssize_t)sizeof n ||
-            write(fds[1], m, strlen(m) + 1) < 0)
-            _exit(4);
-        rs_scene_free(&scene);
-        free(text);
-        _exit(0);
+        close(out[0]);
+        close(err[0]);
+        close(rep[0]);
+        if (dup2(out[1], 1) < 0 || dup2(err[1], 2) < 0)
+            _exit(126);
+        if (fsize_limit > 0) {
+            struct rlimit rl = { (rlim_t)fsize_limit, (rlim_t)fsize_limit };
+            signal(SIGXFSZ, SIG_IGN);
+            if (setrlimit(RLIMIT_FSIZE, &rl) != 0)
+                _exit(125);
+        }
+        execv(MEASURE_CHILD, (char *const *)cmd);
+        _exit(127);
     }
-    close(fds[1]);
+    close(out[1]);
+    close(err[1]);
+    close(rep[1]);
+    if (pid < 0) {
+        close(out[0]);
+        close(err[0]);
+        close(rep[0]);
+        return r;
+    }
     {
-        ssize_t got = read(fds[0], objects, sizeof *objects), k = 0;
-        if (got != (ssize_t)sizeof *objects)
-            *objects = -1;
-        while (k + 1 < (ssize_t)msg_size && (got = read(fds[0], msg + k, 1)) == 1 && msg[k])
-            k++;
-        msg[k] = '\0';
+        struct pollfd pf[2] = { { out[0], POLLIN, 0 }, { err[0], POLLIN, 0 } };
+        int open_fds = 2;
+        while (open_fds > 0) {
+            if (poll(pf, 2, -1) < 0) {
+                if (errno == EINTR)
+                    continue;
+                break;
+            }
+            for (int k = 0; k < 2; k++) {
+                if (pf[k].fd >= 0 && (pf[k].revents & (POLLIN | POLLHUP | POLLERR)) &&
+                    !drain(pf[k].fd, k ? r.err : r.out, k ? sizeof r.err : sizeof r.out)) {
+                    pf[k].fd = -1;
+                    open_fds--;
+                }
+            }
+        }
     }
-    close(fds[0]);
-    while (wait4(pid, &st, 0, &ru) < 0)
-        if (errno != EINTR)
-            return -1;
-    *seconds = now_s() - t0;
-    if (!WIFEXITED(st) || WEXITSTATUS(st) != 0)
+    close(out[0]);
+    close(err[0]);
+    while (waitpid(pid, &st, 0) < 0) {
+        if (errno != EINTR) {
+            close(rep[0]);
+            return r;
+        }
+    }
+    r.seconds = now_s() - t0;
+    {
+        char line[128] = "";
+        int status;
+        long kb;
+        while (drain(rep[0], line, sizeof line))
+            ;
+        if (WIFEXITED(st) && WEXITSTATUS(st) == 0 &&
+            sscanf(line, "status %d peak_kb %ld", &status, &kb) == 2) {
+            r.status = status;
+            r.peak_kb = kb;
+        }
+    }
+    close(rep[0]);
+    return r;
+}
+
+
+/* ---- 10^6 objects ------------------------------------------------------- */
+
+/* Parse `count` copies of `item` in tests/tools/parse_many; returns its peak
+ * RSS in KiB (-1 on failure) and the message / object count it printed. */
+static long parse_many_measured(const char *item, long count, size_t max_objects, char *msg,
+                                size_t msg_size, long *objects, double *seconds)
+{
+    char cnt[32], lim[32];
+    const char *argv[] = { PARSE_MANY, item, cnt, lim, NULL };
+    run_result r;
+    char *nl;
+
+    snprintf(cnt, sizeof cnt, "%ld", count);
+    snprintf(lim, sizeof lim, "%zu", max_objects);
+    r = run_measured(argv, 0);
+    *seconds = r.seconds;
+    *objects = -1;
+    msg[0] = '\0';
+    if (r.status != 0) {
+        snprintf(msg, msg_size, "parse_many exit %d: %.400s", r.status, r.err);
         return -1;
-    return ru.ru_maxrss;
+    }
+    nl = strchr(r.out, '\n');
+    if (!nl || sscanf(r.out, "%ld", objects) != 1)
+        return -1;
+    snprintf(msg, msg_size, "%s", nl + 1);
+    nl = strchr(msg, '\n');
+    if (nl)
+        *nl = '\0';
+    return r.peak_kb;
 }
 
 static void test_many_objects(void)
@@ -589,7 +694,7 @@ static void test_many_objects(void)
     long objects, kb;
     double secs;
 
-    kb = parse_many_in_child("sphere{0,1}\n", 1000000, 0, msg, sizeof msg, &objects, &secs);
+    kb = parse_many_measured("sphere{0,1}\n", 1000000, 0, msg, sizeof msg, &objects, &secs);
     CHECK(kb > 0, "the child parsing 10^6 objects failed (crashed or ran out of memory)");
     CHECK(has_location(msg, "many.scene", 0) && strstr(msg, "many.scene:100001:1: ") == msg &&
               strstr(msg, "too many objects (the limit is 100000)") != NULL,
@@ -603,7 +708,7 @@ static void test_many_objects(void)
            "RSS %.1f MiB (limit %d MiB%s)\n", secs, kb / 1024.0, MAX_OBJECTS_PEAK_MB,
            UNDER_ASAN ? ", ASan build" : "");
 
-    kb = parse_many_in_child("light_source{0,1}\n", 1000000, 0, msg, sizeof msg, &objects,
+    kb = parse_many_measured("light_source{0,1}\n", 1000000, 0, msg, sizeof msg, &objects,
                              &secs);
     CHECK(kb > 0 && strstr(msg, "too many light sources (the limit is 100000)") != NULL &&
               has_location(msg, "many.scene", 0),
@@ -611,7 +716,7 @@ static void test_many_objects(void)
     printf("10^6 light sources: refused, child peak RSS %.1f MiB\n", kb / 1024.0);
 
     /* under the limit: parsed, and the memory is what the objects need */
-    kb = parse_many_in_child("sphere{0,1}\n", 50000, 0, msg, sizeof msg, &objects, &secs);
+    kb = parse_many_measured("sphere{0,1}\n", 50000, 0, msg, sizeof msg, &objects, &secs);
     CHECK(kb > 0 && strcmp(msg, "ok") == 0 && objects == 50000,
           "50,000 objects: '%s', %ld objects", msg, objects);
     printf("50,000 objects: parsed in %.2f s, child peak RSS %.1f MiB (%zu bytes per object)\n",
@@ -741,71 +846,15 @@ static void test_junk(void)
 
 /* ---- lensrender --------------------------------------------------------- */
 
-typedef struct run_result {
-    int status;       /* exit status, 128 + signal, or -1 */
-    long peak_kb;
-    double seconds;
-    char err[2048];   /* stderr (start) */
-} run_result;
-
-/* Run lensrender with args; fsize_limit > 0 sets RLIMIT_FSIZE (SIGXFSZ
- * ignored, so writes fail with EFBIG).  stderr goes to a pipe. */
 static run_result run_lensrender(const char *const *args, long fsize_limit)
 {
-    run_result r;
     const char *argv[32];
-    int n = 0, fds[2], st;
-    pid_t pid;
-    struct rusage ru;
-    double t0 = now_s();
-
-    memset(&r, 0, sizeof r);
-    r.status = -1;
+    int n = 0;
     argv[n++] = LENSRENDER;
     for (int i = 0; args[i] && n < 31; i++)
         argv[n++] = args[i];
     argv[n] = NULL;
-    if (pipe(fds) != 0)
-        return r;
-    fflush(stdout);
-    fflush(stderr);
-    pid = fork();
-    if (pid < 0)
-        return r;
-    if (pid == 0) {
-        int devnull = open("/dev/null", O_WRONLY);
-        close(fds[0]);
-        if (devnull < 0 || dup2(devnull, 1) < 0 || dup2(fds[1], 2) < 0)
-            _exit(126);
-        if (fsize_limit > 0) {
-            struct rlimit rl = { (rlim_t)fsize_limit, (rlim_t)fsize_limit };
-            signal(SIGXFSZ, SIG_IGN);
-            if (setrlimit(RLIMIT_FSIZE, &rl) != 0)
-                _exit(125);
-        }
-        execv(LENSRENDER, (char *const *)argv);
-        _exit(127);
-    }
-    close(fds[1]);
-    {
-        size_t k = 0;
-        char c;
-        while (read(fds[0], &c, 1) == 1)
-            if (k + 1 < sizeof r.err)
-                r.err[k++] = c;
-        r.err[k] = '\0';
-    }
-    close(fds[0]);
-    while (wait4(pid, &st, 0, &ru) < 0)
-        if (errno != EINTR)
-            return r;
-    r.seconds = now_s() - t0;
-    r.peak_kb = ru.ru_maxrss;
-    if (WIFEXITED(st))
-        r.status = WEXITSTATUS(st);
-    else if (WIFSIGNALED(st))
-        r.status = 128 + WTERMSIG(st);
-    return r;
+    return run_measured(argv, fsize_limit);
 }
 
 static int one_line(const char *s)
