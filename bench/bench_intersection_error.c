@@ -10,10 +10,11 @@
  *            at an angle to the axis drawn up to 0, 30, 60 or 85 degrees;
  *   inside:  from a uniform point of the flat back cap (a ray that starts
  *            on the lens) to a uniform point of the front cap.
- * The reference is a long double (x87 80-bit, 64-bit mantissa) solver of
- * the same Spencer & Murty quadratic written here from the geometry,
+ * The reference is a solver of the same Spencer & Murty quadratic written
+ * here from the geometry in ref_real (tests/ref_real.h: IEEE binary128,
+ * 113-bit significand, where the compiler has it; else long double),
  * taking the double ray exactly as given (its direction normalized in
- * long double), so the measured error includes everything the library
+ * that precision), so the measured error includes everything the library
  * does in double: normalizing dir, the world/local transform, the root,
  * the point and the normal.  Only rays whose exact first hit is the
  * front cap are counted; a ray the library sends to another surface is
@@ -44,8 +45,8 @@
 #include <string.h>
 
 #include "lensprim.h"
+#include "ref_real.h"
 
-#define PI_L 3.141592653589793238462643383279502884L
 
 /* splitmix64, fixed seed */
 static uint64_t rng = 0x5eed1e55c0ffee01ULL;
@@ -58,52 +59,52 @@ static uint64_t next_u64(void)
 }
 static double u01(void) { return (double)(next_u64() >> 11) * 0x1.0p-53; }
 
-typedef struct { long double x, y, z; } lv;
-static lv lv_make(long double x, long double y, long double z)
+typedef struct { ref_real x, y, z; } lv;
+static lv lv_make(ref_real x, ref_real y, ref_real z)
 {
     lv v = {x, y, z};
     return v;
 }
-static long double lv_dot(lv a, lv b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static ref_real lv_dot(lv a, lv b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static lv lv_norm(lv a)
 {
-    long double l = sqrtl(lv_dot(a, a));
+    ref_real l = ref_sqrt(lv_dot(a, a));
     return lv_make(a.x / l, a.y / l, a.z / l);
 }
 
 /* The lens in the reference: front cap curvature c1 at z = 0, flat back at
  * z = t, aperture a, rim cylinder between the cap edges. */
 typedef struct {
-    long double c1, t, a, ze;
+    ref_real c1, t, a, ze;
     double size;
 } ref_lens;
 
-static long double sag_l(long double c, long double r)
+static ref_real sag_l(ref_real c, ref_real r)
 {
-    return c * r * r / (1.0L + sqrtl(1.0L - c * c * r * r));
+    return c * r * r / (REF(1.0) + ref_sqrt(REF(1.0) - c * c * r * r));
 }
 
 /* roots of A s^2 + 2 B s + C = 0, ascending */
-static int roots2(long double A, long double B, long double C, long double r[2])
+static int roots2(ref_real A, ref_real B, ref_real C, ref_real r[2])
 {
-    if (A == 0.0L) {
-        if (B == 0.0L)
+    if (A == REF(0.0)) {
+        if (B == REF(0.0))
             return 0;
-        r[0] = -C / (2.0L * B);
+        r[0] = -C / (REF(2.0) * B);
         return 1;
     }
-    long double disc = B * B - A * C;
-    if (disc < 0.0L)
+    ref_real disc = B * B - A * C;
+    if (disc < REF(0.0))
         return 0;
-    long double q = -(B + copysignl(sqrtl(disc), B));
-    if (q == 0.0L) {
-        r[0] = 0.0L;
+    ref_real q = -(B + ref_copysign(ref_sqrt(disc), B));
+    if (q == REF(0.0)) {
+        r[0] = REF(0.0);
         return 1;
     }
     r[0] = q / A;
     r[1] = C / q;
     if (r[1] < r[0]) {
-        long double tmp = r[0];
+        ref_real tmp = r[0];
         r[0] = r[1];
         r[1] = tmp;
     }
@@ -112,33 +113,33 @@ static int roots2(long double A, long double B, long double C, long double r[2])
 
 /* First hit of O + s d (d unit), s > smin: surface 0 front, 1 back, 2 rim,
  * -1 none; point and outward normal. */
-static int ref_hit(const ref_lens *L, lv O, lv d, long double smin, lv *p, lv *n)
+static int ref_hit(const ref_lens *L, lv O, lv d, ref_real smin, lv *p, lv *n)
 {
-    long double best = INFINITY;
+    ref_real best = INFINITY;
     int surf = -1;
-    long double r[2];
+    ref_real r[2];
     int k;
     /* front: c (x^2 + y^2 + z^2) - 2 z = 0, patch r <= a, c z <= 1 */
     {
-        long double c = L->c1;
-        long double B = c * lv_dot(O, d) - d.z, C = c * lv_dot(O, O) - 2.0L * O.z;
+        ref_real c = L->c1;
+        ref_real B = c * lv_dot(O, d) - d.z, C = c * lv_dot(O, O) - REF(2.0) * O.z;
         int nr = roots2(c, B, C, r);
         for (k = 0; k < nr; k++) {
-            long double s = r[k];
+            ref_real s = r[k];
             if (!(s > smin) || s >= best)
                 continue;
             lv q = lv_make(O.x + s * d.x, O.y + s * d.y, O.z + s * d.z);
-            if (q.x * q.x + q.y * q.y > L->a * L->a || c * q.z > 1.0L)
+            if (q.x * q.x + q.y * q.y > L->a * L->a || c * q.z > REF(1.0))
                 continue;
             best = s;
             surf = 0;
             *p = q;
-            *n = lv_norm(lv_make(c * q.x, c * q.y, c * q.z - 1.0L));
+            *n = lv_norm(lv_make(c * q.x, c * q.y, c * q.z - REF(1.0)));
         }
     }
     /* back: z = t */
-    if (d.z != 0.0L) {
-        long double s = (L->t - O.z) / d.z;
+    if (d.z != REF(0.0)) {
+        ref_real s = (L->t - O.z) / d.z;
         if (s > smin && s < best) {
             lv q = lv_make(O.x + s * d.x, O.y + s * d.y, L->t);
             if (q.x * q.x + q.y * q.y <= L->a * L->a) {
@@ -151,11 +152,11 @@ static int ref_hit(const ref_lens *L, lv O, lv d, long double smin, lv *p, lv *n
     }
     /* rim: x^2 + y^2 = a^2, ze <= z <= t */
     {
-        long double A = d.x * d.x + d.y * d.y, B = O.x * d.x + O.y * d.y,
+        ref_real A = d.x * d.x + d.y * d.y, B = O.x * d.x + O.y * d.y,
                     C = O.x * O.x + O.y * O.y - L->a * L->a;
         int nr = roots2(A, B, C, r);
         for (k = 0; k < nr; k++) {
-            long double s = r[k];
+            ref_real s = r[k];
             if (!(s > smin) || s >= best)
                 continue;
             lv q = lv_make(O.x + s * d.x, O.y + s * d.y, O.z + s * d.z);
@@ -220,7 +221,7 @@ static void stats_push(stats *s, double h, double n, double cos_i)
 static void measure_lens(double R, double D, stats *st)
 {
     double a = 0.5 * D;
-    double sag_edge = (double)sag_l(R == 0.0 ? 0.0L : 1.0L / (long double)R, a);
+    double sag_edge = (double)sag_l(R == 0.0 ? REF(0.0) : REF(1.0) / (ref_real)R, a);
     double t = (sag_edge > 0.0 ? sag_edge : 0.0) + 0.1 * D;
 
     lp_lens_desc desc;
@@ -237,7 +238,7 @@ static void measure_lens(double R, double D, stats *st)
     }
 
     ref_lens L;
-    L.c1 = R == 0.0 ? 0.0L : 1.0L / (long double)R;
+    L.c1 = R == 0.0 ? REF(0.0) : REF(1.0) / (ref_real)R;
     L.t = t;
     L.a = a;
     L.ze = sag_l(L.c1, a);
@@ -247,16 +248,16 @@ static void measure_lens(double R, double D, stats *st)
     for (int set = 0; set < 5; set++) {
         for (int i = 0; i < RAYS_PER_SET; i++) {
             /* a uniform target point on the front cap */
-            long double rr = sqrtl(u01()) * L.a, ph = 2.0L * PI_L * u01();
-            lv T = lv_make(rr * cosl(ph), rr * sinl(ph), 0);
+            ref_real rr = ref_sqrt(u01()) * L.a, ph = REF(2.0) * REF_PI * u01();
+            lv T = lv_make(rr * ref_cos(ph), rr * ref_sin(ph), 0);
             T.z = sag_l(L.c1, rr);
             lp_vec3 o, dir;
             if (set < 4) {
                 /* from outside, at an angle up to max_angle to the axis */
-                long double beta = (long double)max_angle_deg[set] * PI_L / 180.0L * u01();
-                long double az = 2.0L * PI_L * u01();
-                lv d = lv_make(sinl(beta) * cosl(az), sinl(beta) * sinl(az), cosl(beta));
-                long double dist = 2.0L * L.size;
+                ref_real beta = (ref_real)max_angle_deg[set] * REF_PI / REF(180.0) * u01();
+                ref_real az = REF(2.0) * REF_PI * u01();
+                lv d = lv_make(ref_sin(beta) * ref_cos(az), ref_sin(beta) * ref_sin(az), ref_cos(beta));
+                ref_real dist = REF(2.0) * L.size;
                 o.x = (double)(T.x - dist * d.x);
                 o.y = (double)(T.y - dist * d.y);
                 o.z = (double)(T.z - dist * d.z);
@@ -265,9 +266,9 @@ static void measure_lens(double R, double D, stats *st)
                 dir.z = (double)d.z;
             } else {
                 /* from a point of the flat back cap, through the glass */
-                long double rb = sqrtl(u01()) * L.a, pb = 2.0L * PI_L * u01();
-                o.x = (double)(rb * cosl(pb));
-                o.y = (double)(rb * sinl(pb));
+                ref_real rb = ref_sqrt(u01()) * L.a, pb = REF(2.0) * REF_PI * u01();
+                o.x = (double)(rb * ref_cos(pb));
+                o.y = (double)(rb * ref_sin(pb));
                 o.z = t;
                 dir.x = (double)(T.x - o.x);
                 dir.y = (double)(T.y - o.y);
@@ -277,7 +278,7 @@ static void measure_lens(double R, double D, stats *st)
             lv d = lv_norm(lv_make(dir.x, dir.y, dir.z));
             lv p, n;
             /* a ray from the back cap leaves it: exclude its own root */
-            long double smin = set < 4 ? 0.0L : 1e-9L * L.size;
+            ref_real smin = set < 4 ? REF(0.0) : REF(1e-9) * L.size;
             int surf = ref_hit(&L, O, d, smin, &p, &n);
             if (surf != 0)
                 continue; /* only front-cap hits are measured */
@@ -287,11 +288,11 @@ static void measure_lens(double R, double D, stats *st)
                 st->mismatches++;
                 continue;
             }
-            long double dx = h.point.x - p.x, dy = h.point.y - p.y, dz = h.point.z - p.z;
-            long double nx = h.normal.x - n.x, ny = h.normal.y - n.y, nz = h.normal.z - n.z;
-            double eh = (double)(sqrtl(dx * dx + dy * dy + dz * dz) / L.size);
-            double en = (double)sqrtl(nx * nx + ny * ny + nz * nz);
-            double ci = (double)fabsl(lv_dot(d, n));
+            ref_real dx = h.point.x - p.x, dy = h.point.y - p.y, dz = h.point.z - p.z;
+            ref_real nx = h.normal.x - n.x, ny = h.normal.y - n.y, nz = h.normal.z - n.z;
+            double eh = (double)(ref_sqrt(dx * dx + dy * dy + dz * dz) / L.size);
+            double en = (double)ref_sqrt(nx * nx + ny * ny + nz * nz);
+            double ci = (double)ref_fabs(lv_dot(d, n));
             stats_push(st, eh, en, ci);
         }
     }
@@ -312,15 +313,15 @@ static void print_page_head(void)
            "front cap from two lens sizes away at angles to the axis drawn up\n"
            "to 0, 30, 60 and 85 degrees, and from a uniform point of the flat\n"
            "back cap through the glass (rays starting on the lens).\n\n"
-           "Reference: the same Spencer & Murty quadratic solved in long double\n"
-           "(80-bit, 64-bit mantissa) for the double ray exactly as given, so\n"
-           "the error includes everything done in double (normalizing the\n"
-           "direction, the world/local transform, the root, the point, the\n"
-           "normal).  `size` is the lens size (max of D and its axial extent);\n"
-           "the normal error is |n - n_exact|, i.e. the angle in radians.\n"
+           "Reference: the same Spencer & Murty quadratic solved in %s\n"
+           "for the double ray exactly as given, so the error includes\n"
+           "everything done in double (normalizing the direction, the\n"
+           "world/local transform, the root, the point, the normal).\n"
+           "`size` is the lens size (max of D and its axial extent); the\n"
+           "normal error is |n - n_exact|, i.e. the angle in radians.\n"
            "Mismatches are rays whose exact first hit is the front cap but\n"
            "the library reports another surface (or none).\n\n",
-           RAYS_PER_SET);
+           RAYS_PER_SET, REF_NAME);
 }
 
 /* The page's closing text, from the measured numbers. */

@@ -8,7 +8,9 @@
  *   - bad input exits 2 with one line on stderr; a POV-Ray that cannot be
  *     run exits 1 and says so;
  *   - `pov_compare --all LP_SOURCE_DIR/scenes` at 320 x 240 (into
- *     LP_TEST_TMP): for EVERY scene, report.json parses and holds every
+ *     LP_TEST_TMP; the environment variable LP_POV_COMPARE_SIZE=WxH sets
+ *     another size, e.g. 80x60 under valgrind, where memcheck runs the
+ *     renderer 30-50x slower; every check below applies at any size): for EVERY scene, report.json parses and holds every
  *     key of the contract; the lens silhouettes agree (IoU >= 0.999,
  *     largest boundary displacement <= 1 px); and where POV-Ray can
  *     express the scene (no polarizer notes) our fresnel render matches
@@ -46,6 +48,25 @@
 #define MIN_IOU 0.999
 #define MAX_BOUNDARY_PX 1.0
 #define MIN_PSNR_DB 40.0
+
+/* The image size of the --all run: 320 x 240, or LP_POV_COMPARE_SIZE. */
+static int size_w = 320, size_h = 240;
+
+static void read_size(void)
+{
+    const char *e = getenv("LP_POV_COMPARE_SIZE");
+    int w, h;
+    char extra;
+    if (!e || !*e)
+        return;
+    if (sscanf(e, "%dx%d%c", &w, &h, &extra) == 2 && w >= 16 && h >= 12 && w <= 4096 &&
+        h <= 4096) {
+        size_w = w;
+        size_h = h;
+    } else {
+        CHECK(0, "LP_POV_COMPARE_SIZE='%s': want WxH (16x12 to 4096x4096)", e);
+    }
+}
 
 static const char *const POV_COMPARE = LP_BIN_DIR "/pov_compare";
 static const char *const SCENES = LP_SOURCE_DIR "/scenes";
@@ -474,9 +495,9 @@ static void check_scene(const char *file)
     for (size_t k = 0; k < sizeof REQUIRED_NUMBERS / sizeof *REQUIRED_NUMBERS; k++)
         CHECK(isfinite(jnum(&root, REQUIRED_NUMBERS[k], 0)),
               "%s: report.json: %s missing or not a number", file, REQUIRED_NUMBERS[k]);
-    CHECK(jnum(&root, "width", 0) == 320 && jnum(&root, "height", 0) == 240,
-          "%s: report.json size %g x %g, want 320 x 240", file, jnum(&root, "width", 0),
-          jnum(&root, "height", 0));
+    CHECK(jnum(&root, "width", 0) == size_w && jnum(&root, "height", 0) == size_h,
+          "%s: report.json size %g x %g, want %d x %d", file, jnum(&root, "width", 0),
+          jnum(&root, "height", 0), size_w, size_h);
     CHECK(jnum(&root, "depth", 0) >= 1, "%s: depth %g", file, jnum(&root, "depth", 0));
     static const char *const modes[] = {"fresnel", "schlick", "polarized", "rgb"};
     for (int k = 0; k < 4; k++) {
@@ -542,11 +563,15 @@ int main(void)
     }
     test_cli_errors();
 
-    char out[512], err[512];
+    char out[512], err[512], ws[16], hs[16];
     snprintf(out, sizeof out, "%s/pc_all_stdout.txt", LP_TEST_TMP);
     snprintf(err, sizeof err, "%s/pc_all_stderr.txt", LP_TEST_TMP);
+    read_size();
+    snprintf(ws, sizeof ws, "%d", size_w);
+    snprintf(hs, sizeof hs, "%d", size_h);
+    printf("pov_compare --all at %d x %d\n", size_w, size_h);
     char *argv[] = {(char *)POV_COMPARE, "--all", (char *)SCENES, "--out", (char *)OUT,
-                    "--width", "320", "--height", "240", NULL};
+                    "--width", ws, "--height", hs, NULL};
     int rc = run(argv, out, err);
     char *e = read_text(err);
     CHECK(rc == 0, "pov_compare --all %s: exit %d: %s", SCENES, rc, e ? e : "");
