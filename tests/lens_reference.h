@@ -1,12 +1,12 @@
 /* lens_reference.h -- an independent reference for the lens tests.
  *
  * Shared by the property tests (energy, reciprocity, rim): a fixed-seed
- * PRNG (splitmix64), small vector helpers, a long-double reference lens
- * (Spencer & Murty caps, cylinder/cone rim) with its own intersector and
- * inside test written from the geometry alone, and random valid lenses of
- * every classical family.  Nothing here calls the code under test except
- * to create the lens the reference describes.  Include after check.h and
- * lensprim.h. */
+ * PRNG (splitmix64), small vector helpers, a reference lens in ref_real
+ * (binary128 where available, see ref_real.h; Spencer & Murty caps,
+ * cylinder/cone rim) with its own intersector and inside test written
+ * from the geometry alone, and random valid lenses of every classical
+ * family.  Nothing here calls the code under test except to create the
+ * lens the reference describes.  Include after check.h and lensprim.h. */
 #ifndef LP_TEST_LENS_REFERENCE_H
 #define LP_TEST_LENS_REFERENCE_H
 
@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "lensprim.h"
+#include "ref_real.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -56,14 +57,14 @@ static inline lp_vec3 rand_unit(void)
     }
 }
 
-typedef struct { long double x, y, z; } lv3;
-static lv3 L3(long double x, long double y, long double z) { lv3 v = {x, y, z}; return v; }
+typedef struct { ref_real x, y, z; } lv3;
+static lv3 L3(ref_real x, ref_real y, ref_real z) { lv3 v = {x, y, z}; return v; }
 static inline lv3 ladd(lv3 a, lv3 b) { return L3(a.x + b.x, a.y + b.y, a.z + b.z); }
 static inline lv3 lsub(lv3 a, lv3 b) { return L3(a.x - b.x, a.y - b.y, a.z - b.z); }
-static inline lv3 lscale(lv3 a, long double s) { return L3(a.x * s, a.y * s, a.z * s); }
-static inline long double ldot(lv3 a, lv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static inline long double llen(lv3 a) { return sqrtl(ldot(a, a)); }
-static inline lv3 lnorm(lv3 a) { return lscale(a, 1.0L / llen(a)); }
+static inline lv3 lscale(lv3 a, ref_real s) { return L3(a.x * s, a.y * s, a.z * s); }
+static inline ref_real ldot(lv3 a, lv3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline ref_real llen(lv3 a) { return ref_sqrt(ldot(a, a)); }
+static inline lv3 lnorm(lv3 a) { return lscale(a, REF(1.0) / llen(a)); }
 static inline lv3 lfrom(lp_vec3 a) { return L3(a.x, a.y, a.z); }
 static inline lp_vec3 lto(lv3 a) { return V((double)a.x, (double)a.y, (double)a.z); }
 
@@ -81,12 +82,12 @@ static inline frame frame_make(lp_vec3 P, lp_vec3 A)
     return f;
 }
 static inline frame frame_identity(void) { return frame_make(V(0, 0, 0), V(0, 0, 1)); }
-/* local -> world, in long double */
+/* local -> world, in ref_real */
 static inline lv3 fw_point(const frame *f, lv3 p)
 {
-    return L3((long double)f->P.x + f->e1.x * p.x + f->e2.x * p.y + f->A.x * p.z,
-              (long double)f->P.y + f->e1.y * p.x + f->e2.y * p.y + f->A.y * p.z,
-              (long double)f->P.z + f->e1.z * p.x + f->e2.z * p.y + f->A.z * p.z);
+    return L3((ref_real)f->P.x + f->e1.x * p.x + f->e2.x * p.y + f->A.x * p.z,
+              (ref_real)f->P.y + f->e1.y * p.x + f->e2.y * p.y + f->A.y * p.z,
+              (ref_real)f->P.z + f->e1.z * p.x + f->e2.z * p.y + f->A.z * p.z);
 }
 static inline lv3 fw_dir(const frame *f, lv3 d)
 {
@@ -94,10 +95,10 @@ static inline lv3 fw_dir(const frame *f, lv3 d)
               f->e1.y * d.x + f->e2.y * d.y + f->A.y * d.z,
               f->e1.z * d.x + f->e2.z * d.y + f->A.z * d.z);
 }
-/* world -> local, in long double */
+/* world -> local, in ref_real */
 static inline lv3 fl_point(const frame *f, lp_vec3 w)
 {
-    lv3 d = L3((long double)w.x - f->P.x, (long double)w.y - f->P.y, (long double)w.z - f->P.z);
+    lv3 d = L3((ref_real)w.x - f->P.x, (ref_real)w.y - f->P.y, (ref_real)w.z - f->P.z);
     return L3(d.x * f->e1.x + d.y * f->e1.y + d.z * f->e1.z,
               d.x * f->e2.x + d.y * f->e2.y + d.z * f->e2.z,
               d.x * f->A.x + d.y * f->A.y + d.z * f->A.z);
@@ -124,21 +125,24 @@ static inline int has_word(const char *msg, const char *word)
 }
 
 /* ------------------------------------------------------------------ */
-/* reference lens geometry, long double, local frame                   */
+/* reference lens geometry, ref_real, local frame                      */
 /* ------------------------------------------------------------------ */
 
 typedef struct {
-    long double c1, c2, t, a1, a2, zf, zb, k;
+    ref_real c1, c2, t, a1, a2, zf, zb, k;
     int rim;
     double size;
 } ref_lens;
 
-static inline long double curv(double R) { return (R == 0.0 || isinf(R)) ? 0.0L : 1.0L / (long double)R; }
+static inline ref_real curv(double R)
+{
+    return (R == 0.0 || isinf(R)) ? REF(0.0) : REF(1.0) / (ref_real)R;
+}
 /* sag(h) = R - sign(R) sqrt(R^2 - h^2), written without cancellation:
  * c h^2 / (1 + sqrt(1 - c^2 h^2)), c = 1/R (0 for flat). */
-static inline long double rsag(long double c, long double h)
+static inline ref_real rsag(ref_real c, ref_real h)
 {
-    return c * h * h / (1.0L + sqrtl(1.0L - c * c * h * h));
+    return c * h * h / (REF(1.0) + ref_sqrt(REF(1.0) - c * c * h * h));
 }
 
 static inline void ref_init(ref_lens *L, double R1, double R2, double t, double D, double D2)
@@ -150,33 +154,33 @@ static inline void ref_init(ref_lens *L, double R1, double R2, double t, double 
     L->a2 = (D2 > 0 ? D2 : D) / 2;
     L->zf = rsag(L->c1, L->a1);
     L->zb = t + rsag(L->c2, L->a2);
-    double zmin = (double)fminl(0.0L, L->zf), zmax = (double)fmaxl(t, L->zb);
+    double zmin = (double)ref_fmin(REF(0.0), L->zf), zmax = (double)ref_fmax(t, L->zb);
     L->size = fmax(fmax(D, D2), zmax - zmin);
-    L->rim = (L->zb - L->zf) > 1e-12L * L->size;
-    L->k = L->rim ? (L->a2 - L->a1) / (L->zb - L->zf) : 0.0L;
+    L->rim = (L->zb - L->zf) > REF(1e-12) * L->size;
+    L->k = L->rim ? (L->a2 - L->a1) / (L->zb - L->zf) : REF(0.0);
 }
 
 typedef struct {
-    long double s;
+    ref_real s;
     lv3 p, n;
     int surf;
 } ref_hit;
 
 /* roots of A s^2 + 2 B s + C = 0 (stable form) */
-static inline int quad_roots(long double A, long double B, long double C, long double r[2])
+static inline int quad_roots(ref_real A, ref_real B, ref_real C, ref_real r[2])
 {
-    if (A == 0.0L) {
-        if (B == 0.0L)
+    if (A == REF(0.0)) {
+        if (B == REF(0.0))
             return 0;
-        r[0] = -C / (2.0L * B);
+        r[0] = -C / (REF(2.0) * B);
         return 1;
     }
-    long double disc = B * B - A * C;
-    if (disc < 0.0L)
+    ref_real disc = B * B - A * C;
+    if (disc < REF(0.0))
         return 0;
-    long double q = -(B + copysignl(sqrtl(disc), B));
-    if (q == 0.0L) {
-        r[0] = 0.0L;
+    ref_real q = -(B + ref_copysign(ref_sqrt(disc), B));
+    if (q == REF(0.0)) {
+        r[0] = REF(0.0);
         return 1;
     }
     r[0] = q / A;
@@ -184,7 +188,7 @@ static inline int quad_roots(long double A, long double B, long double C, long d
     return 2;
 }
 
-static inline void consider(ref_hit *best, long double s, lv3 p, lv3 n, int surf)
+static inline void consider(ref_hit *best, ref_real s, lv3 p, lv3 n, int surf)
 {
     if (best->surf < 0 || s < best->s) {
         best->s = s;
@@ -195,17 +199,17 @@ static inline void consider(ref_hit *best, long double s, lv3 p, lv3 n, int surf
 }
 
 /* Nearest surface hit of O + s d, s > smin (d unit). surf -1: none. */
-static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, long double smin)
+static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, ref_real smin)
 {
     ref_hit best;
     best.surf = -1;
     best.s = 0;
     for (int side = 0; side < 2; side++) {
-        long double c = side ? L->c2 : L->c1, z0 = side ? L->t : 0.0L, a = side ? L->a2 : L->a1;
-        long double Z = O.z - z0;
-        long double A = c, B = c * (O.x * d.x + O.y * d.y + Z * d.z) - d.z;
-        long double C = c * (O.x * O.x + O.y * O.y + Z * Z) - 2.0L * Z;
-        long double r[2];
+        ref_real c = side ? L->c2 : L->c1, z0 = side ? L->t : REF(0.0), a = side ? L->a2 : L->a1;
+        ref_real Z = O.z - z0;
+        ref_real A = c, B = c * (O.x * d.x + O.y * d.y + Z * d.z) - d.z;
+        ref_real C = c * (O.x * O.x + O.y * O.y + Z * Z) - REF(2.0) * Z;
+        ref_real r[2];
         int nr = quad_roots(A, B, C, r);
         for (int i = 0; i < nr; i++) {
             if (!(r[i] > smin))
@@ -213,20 +217,20 @@ static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, long double
             lv3 p = ladd(O, lscale(d, r[i]));
             if (p.x * p.x + p.y * p.y > a * a)
                 continue;
-            if (c * (p.z - z0) >= 1.0L)
+            if (c * (p.z - z0) >= REF(1.0))
                 continue;
             /* outward normal: front +grad G1, back -grad G2 */
-            lv3 g = L3(c * p.x, c * p.y, c * (p.z - z0) - 1.0L);
-            lv3 n = lnorm(side ? lscale(g, -1.0L) : g);
+            lv3 g = L3(c * p.x, c * p.y, c * (p.z - z0) - REF(1.0));
+            lv3 n = lnorm(side ? lscale(g, -REF(1.0)) : g);
             consider(&best, r[i], p, n, side ? LP_SURFACE_BACK : LP_SURFACE_FRONT);
         }
     }
     if (L->rim) {
-        long double R0 = L->a1 + L->k * (O.z - L->zf);
-        long double A = d.x * d.x + d.y * d.y - L->k * L->k * d.z * d.z;
-        long double B = O.x * d.x + O.y * d.y - R0 * L->k * d.z;
-        long double C = O.x * O.x + O.y * O.y - R0 * R0;
-        long double r[2];
+        ref_real R0 = L->a1 + L->k * (O.z - L->zf);
+        ref_real A = d.x * d.x + d.y * d.y - L->k * L->k * d.z * d.z;
+        ref_real B = O.x * d.x + O.y * d.y - R0 * L->k * d.z;
+        ref_real C = O.x * O.x + O.y * O.y - R0 * R0;
+        ref_real r[2];
         int nr = quad_roots(A, B, C, r);
         for (int i = 0; i < nr; i++) {
             if (!(r[i] > smin))
@@ -234,7 +238,7 @@ static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, long double
             lv3 p = ladd(O, lscale(d, r[i]));
             if (p.z < L->zf || p.z > L->zb)
                 continue;
-            long double rr = L->a1 + L->k * (p.z - L->zf);
+            ref_real rr = L->a1 + L->k * (p.z - L->zf);
             lv3 n = lnorm(L3(p.x, p.y, -rr * L->k));
             consider(&best, r[i], p, n, LP_SURFACE_RIM);
         }
@@ -244,15 +248,15 @@ static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, long double
 
 /* Inside test with a margin (a lower bound-ish of the distance to the
  * boundary, vertical for the caps). */
-static inline int ref_inside(const ref_lens *L, lv3 p, long double *margin)
+static inline int ref_inside(const ref_lens *L, lv3 p, ref_real *margin)
 {
-    long double r = sqrtl(p.x * p.x + p.y * p.y);
-    long double rmax = fmaxl(L->a1, L->a2);
+    ref_real r = ref_sqrt(p.x * p.x + p.y * p.y);
+    ref_real rmax = ref_fmax(L->a1, L->a2);
     if (r >= rmax) {
         *margin = r - rmax;
         return 0;
     }
-    long double lower, upper;
+    ref_real lower, upper;
     if (r <= L->a1)
         lower = rsag(L->c1, r);
     else
@@ -261,8 +265,8 @@ static inline int ref_inside(const ref_lens *L, lv3 p, long double *margin)
         upper = L->t + rsag(L->c2, r);
     else
         upper = L->zf + (r - L->a1) / L->k; /* cone, a1 > a2 */
-    long double m = fminl(fabsl(p.z - lower), fabsl(p.z - upper));
-    m = fminl(m, rmax - r);
+    ref_real m = ref_fmin(ref_fabs(p.z - lower), ref_fabs(p.z - upper));
+    m = ref_fmin(m, rmax - r);
     *margin = m;
     return p.z > lower && p.z < upper;
 }
@@ -392,19 +396,19 @@ static inline void random_medium(lp_glass *g)
 /* A random point on (or near) the lens surface, local frame. */
 static inline lv3 random_surface_point(const ref_lens *L, int which)
 {
-    long double phi = urange(0, 2 * M_PI);
+    ref_real phi = urange(0, 2 * M_PI);
     if (which == 2 && L->rim) {
-        long double u = urand();
-        long double z = L->zf + u * (L->zb - L->zf), r = L->a1 + u * (L->a2 - L->a1);
-        return L3(r * cosl(phi), r * sinl(phi), z);
+        ref_real u = urand();
+        ref_real z = L->zf + u * (L->zb - L->zf), r = L->a1 + u * (L->a2 - L->a1);
+        return L3(r * ref_cos(phi), r * ref_sin(phi), z);
     }
     int back = which == 1;
-    long double a = back ? L->a2 : L->a1, r = sqrtl(urand()) * a;
-    long double z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
-    return L3(r * cosl(phi), r * sinl(phi), z);
+    ref_real a = back ? L->a2 : L->a1, r = ref_sqrt(urand()) * a;
+    ref_real z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
+    return L3(r * ref_cos(phi), r * ref_sin(phi), z);
 }
 
-/* Reflection and refraction of long-double directions. */
+/* Reflection and refraction of ref_real directions. */
 static inline lv3 lcross(lv3 a, lv3 b)
 {
     return L3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
@@ -412,14 +416,14 @@ static inline lv3 lcross(lv3 a, lv3 b)
 
 static inline lv3 lreflect(lv3 d, lv3 n) { return ladd(d, lscale(n, -2 * ldot(d, n))); }
 
-static inline int lrefract(lv3 d, lv3 n, long double n1, long double n2, lv3 *out)
+static inline int lrefract(lv3 d, lv3 n, ref_real n1, ref_real n2, lv3 *out)
 {
     lv3 m = ldot(d, n) < 0 ? n : lscale(n, -1); /* toward the incident side */
-    long double ci = -ldot(d, m), eta = n1 / n2;
-    long double st2 = eta * eta * (1 - ci) * (1 + ci);
+    ref_real ci = -ldot(d, m), eta = n1 / n2;
+    ref_real st2 = eta * eta * (1 - ci) * (1 + ci);
     if (st2 >= 1)
         return 0;
-    long double ct = sqrtl(1 - st2);
+    ref_real ct = ref_sqrt(1 - st2);
     *out = lnorm(ladd(lscale(d, eta), lscale(m, eta * ci - ct)));
     return 1;
 }

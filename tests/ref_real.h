@@ -12,11 +12,15 @@
  *
  * Use ref_real / ref_complex for reference quantities, REF(1.5) for
  * literals that need full precision, the ref_* functions below for
- * elementary functions, and (double) casts to print. */
+ * elementary functions, and (double) casts to print.
+ *
+ * This header does not include <complex.h>: its macro I would clash with
+ * the many variables named I (intensities) in the tests.  A test that
+ * uses ref_complex and the complex ref_* functions includes <complex.h>
+ * itself. */
 #ifndef LP_TEST_REF_REAL_H
 #define LP_TEST_REF_REAL_H
 
-#include <complex.h>
 #include <float.h>
 #include <math.h>
 

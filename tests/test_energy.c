@@ -13,8 +13,9 @@
  * (ellipse axes).  A fixed-seed splitmix64 generator makes every failure
  * reproducible; messages carry the seed, lens and ray index.
  *
- * Geometry references (long double) and the Fresnel reflectances are
- * written here; nothing expected comes from the library.
+ * Geometry references (ref_real: binary128 where available) and the
+ * Fresnel reflectances are written here; nothing expected comes from the
+ * library.
  */
 #include <float.h>
 #include <math.h>
@@ -29,6 +30,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 #include "lensprim.h"
+#include "ref_real.h"
 
 /* ------------------------------------------------------------------ */
 /* small helpers                                                       */
@@ -37,22 +39,22 @@
 #include "lens_reference.h"
 
 /* ------------------------------------------------------------------ */
-/* Fresnel, written here (Born & Wolf), long double                    */
+/* Fresnel, written here (Born & Wolf), ref_real                       */
 /* ------------------------------------------------------------------ */
 
 /* Reflectances at incidence cosine ci from n1 into n2; 1, 1 under TIR. */
-static void fresnel_R(long double ci, long double n1, long double n2, long double *Rs,
-                      long double *Rp, long double *ct_out)
+static void fresnel_R(ref_real ci, ref_real n1, ref_real n2, ref_real *Rs,
+                      ref_real *Rp, ref_real *ct_out)
 {
-    long double st2 = (n1 / n2) * (n1 / n2) * (1 - ci) * (1 + ci);
+    ref_real st2 = (n1 / n2) * (n1 / n2) * (1 - ci) * (1 + ci);
     if (st2 >= 1) {
         *Rs = *Rp = 1;
         *ct_out = -1;
         return;
     }
-    long double ct = sqrtl(1 - st2);
-    long double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
-    long double rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
+    ref_real ct = ref_sqrt(1 - st2);
+    ref_real rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
+    ref_real rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
     *Rs = rs * rs;
     *Rp = rp * rp;
     *ct_out = ct;
@@ -66,20 +68,20 @@ static long n_rays_total, n_hits_total, n_leaks, n_tir_pairs, n_rim_rays, n_trun
 static double worst_balance;
 
 /* distance-like residual of a point from a cap surface (local) */
-static long double cap_residual(const ref_lens *L, lv3 p, int back)
+static ref_real cap_residual(const ref_lens *L, lv3 p, int back)
 {
-    long double c = back ? L->c2 : L->c1, z0 = back ? L->t : 0.0L;
-    long double Z = p.z - z0;
-    long double G = c * (p.x * p.x + p.y * p.y + Z * Z) - 2 * Z;
-    long double g = 2 * sqrtl(c * c * (p.x * p.x + p.y * p.y) + (c * Z - 1) * (c * Z - 1));
-    return fabsl(G) / g;
+    ref_real c = back ? L->c2 : L->c1, z0 = back ? L->t : REF(0.0);
+    ref_real Z = p.z - z0;
+    ref_real G = c * (p.x * p.x + p.y * p.y + Z * Z) - 2 * Z;
+    ref_real g = 2 * ref_sqrt(c * c * (p.x * p.x + p.y * p.y) + (c * Z - 1) * (c * Z - 1));
+    return ref_fabs(G) / g;
 }
 
 static lv3 cap_normal(const ref_lens *L, lv3 p, int back)
 {
-    long double c = back ? L->c2 : L->c1, z0 = back ? L->t : 0.0L;
-    lv3 g = L3(c * p.x, c * p.y, c * (p.z - z0) - 1.0L);
-    return lnorm(back ? lscale(g, -1.0L) : g);
+    ref_real c = back ? L->c2 : L->c1, z0 = back ? L->t : REF(0.0);
+    lv3 g = L3(c * p.x, c * p.y, c * (p.z - z0) - REF(1.0));
+    return lnorm(back ? lscale(g, -REF(1.0)) : g);
 }
 
 /* expected path bits of the single chain through a lens: node 1 a
@@ -90,14 +92,14 @@ static uint64_t chain_path(int d) { return d == 1 ? 1u : (((uint64_t)1 << (d - 1
 typedef struct {
     int robust;      /* the reference hit is far from edges and not grazing */
     int surf;        /* its surface */
-    long double cos_i;
+    ref_real cos_i;
     lv3 n;           /* local outward normal at the hit */
 } ref_entry;
 
 static ref_entry classify(const ref_lens *L, lv3 O, lv3 d)
 {
     ref_entry e;
-    ref_hit h = ref_intersect(L, O, d, 0.0L);
+    ref_hit h = ref_intersect(L, O, d, REF(0.0));
     e.surf = h.surf;
     e.robust = 0;
     e.cos_i = 0;
@@ -105,13 +107,13 @@ static ref_entry classify(const ref_lens *L, lv3 O, lv3 d)
         return e;
     e.n = h.n;
     e.cos_i = -ldot(d, h.n);
-    long double m = 1e-7L * L->size;
-    int ok = e.cos_i > 1e-3L;
+    ref_real m = REF(1e-7) * L->size;
+    int ok = e.cos_i > REF(1e-3);
     if (h.surf == LP_SURFACE_RIM) {
         ok = ok && h.p.z - L->zf > m && L->zb - h.p.z > m;
     } else {
-        long double a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
-        ok = ok && sqrtl(h.p.x * h.p.x + h.p.y * h.p.y) < a - m;
+        ref_real a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
+        ok = ok && ref_sqrt(h.p.x * h.p.x + h.p.y * h.p.y) < a - m;
     }
     e.robust = ok;
     return e;
@@ -211,13 +213,13 @@ static void check_trace(const ref_lens *L, const frame *f, const lp_glass *glass
         if (o->surface == LP_SURFACE_FRONT || o->surface == LP_SURFACE_BACK) {
             int back = o->surface == LP_SURFACE_BACK;
             lv3 p = fl_point(f, r->origin);
-            long double a = back ? L->a2 : L->a1;
-            CHECK(cap_residual(L, p, back) <= 1e-9L * L->size, "%s: ray %zu origin %.3Lg off its cap",
-                  ctx, i, cap_residual(L, p, back));
-            CHECK(sqrtl(p.x * p.x + p.y * p.y) <= a * (1 + 1e-9L), "%s: ray %zu origin outside the cap",
-                  ctx, i);
+            ref_real a = back ? L->a2 : L->a1;
+            CHECK(cap_residual(L, p, back) <= REF(1e-9) * L->size, "%s: ray %zu origin %.3g off its cap",
+                  ctx, i, (double)cap_residual(L, p, back));
+            CHECK(ref_sqrt(p.x * p.x + p.y * p.y) <= a * (1 + REF(1e-9)),
+                  "%s: ray %zu origin outside the cap", ctx, i);
             lv3 n = cap_normal(L, p, back);
-            CHECK(ldot(fl_dir(f, r->dir), n) >= -1e-9L, "%s: ray %zu points into the glass", ctx, i);
+            CHECK(ldot(fl_dir(f, r->dir), n) >= -REF(1e-9), "%s: ray %zu points into the glass", ctx, i);
         }
     }
     if (res->count)
@@ -294,9 +296,9 @@ static void random_ray(const ref_lens *L, const frame *f, lp_ray *in)
     else
         T = random_surface_point(L, 2);
     if (sm64() % 4 == 0) /* some misses and grazing rays */
-        T = ladd(T, lscale(lfrom(rand_unit()), 0.05L * L->size * urand()));
+        T = ladd(T, lscale(lfrom(rand_unit()), REF(0.05) * L->size * urand()));
     lp_vec3 dir = rand_unit();
-    lv3 O = lsub(T, lscale(lfrom(dir), 2.0L * L->size));
+    lv3 O = lsub(T, lscale(lfrom(dir), REF(2.0) * L->size));
     make_ray(in, lto(fw_point(f, O)), lto(fw_dir(f, lfrom(dir))));
 }
 
@@ -573,23 +575,23 @@ static void test_skip_external(void)
             /* Fresnel at the entry node, computed here */
             lv3 Ol = fl_point(&f, in.origin), dl = lnorm(fl_dir(&f, in.dir));
             ref_entry ent = classify(&L, Ol, dl);
-            if (refl && ent.robust && ent.surf != LP_SURFACE_RIM && ent.cos_i > 0.01L) {
-                long double Rs, Rp, ct;
+            if (refl && ent.robust && ent.surf != LP_SURFACE_RIM && ent.cos_i > REF(0.01)) {
+                ref_real Rs, Rp, ct;
                 fresnel_R(ent.cos_i, nm, ng, &Rs, &Rp, &ct);
-                long double R;
+                ref_real R;
                 if (args.mode == LP_MODE_POLARIZED) {
                     lv3 v = fl_dir(&f, in.vp);
                     v = lnorm(lsub(v, lscale(dl, ldot(v, dl))));
                     lv3 sx = L3(dl.y * ent.n.z - dl.z * ent.n.y, dl.z * ent.n.x - dl.x * ent.n.z,
                                 dl.x * ent.n.y - dl.y * ent.n.x);
-                    long double as2 = llen(sx) > 1e-9L ? powl(ldot(v, lnorm(sx)), 2) : 1.0L;
+                    ref_real as2 = llen(sx) > REF(1e-9) ? ref_pow(ldot(v, lnorm(sx)), 2) : REF(1.0);
                     R = Rs * as2 + Rp * (1 - as2);
                 } else if (args.mode == LP_MODE_FRESNEL) {
                     R = (Rs + Rp) / 2;
                 } else {
-                    long double R0 = powl((nm - ng) / (nm + ng), 2);
-                    long double c = nm <= ng ? ent.cos_i : ct;
-                    R = ct < 0 ? 1.0L : R0 + (1 - R0) * powl(1 - c, 5);
+                    ref_real R0 = ref_pow((nm - ng) / (nm + ng), 2);
+                    ref_real c = nm <= ng ? ent.cos_i : ct;
+                    R = ct < 0 ? REF(1.0) : R0 + (1 - R0) * ref_pow(1 - c, 5);
                 }
                 CHECK_ABS(r1 / in.intensity, (double)R, 1e-12 + 1e-10 * (double)R,
                           "%s: depth-1 reflectance vs Fresnel (mode %d)", ctx, (int)args.mode);

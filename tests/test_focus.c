@@ -8,7 +8,7 @@
  * entering from behind see the mirrored lens R1' = -R2, R2' = -R1 and
  * focus at BFL' in front of the front vertex.  Real (marginal) rays are
  * compared with an exact meridional trace written here (Snell's law at
- * two spheres, long double), and the third-order trend of spherical
+ * two spheres, ref_real), and the third-order trend of spherical
  * aberration, LA ~ h^2, is checked by the ratio LA(h)/LA(h/2) ~ 4.
  * Nothing expected is taken from the library.
  */
@@ -19,6 +19,7 @@
 
 #include "check.h"
 #include "lensprim.h"
+#include "ref_real.h"
 
 static const double N_GLASS = 1.5168;
 
@@ -44,72 +45,72 @@ static double bfl_formula(double R1, double R2, double t, double n)
     return f * (1 - (n - 1) * t * c1 / n);
 }
 
-/* ---- exact meridional trace (x, z), long double ------------------- */
+/* ---- exact meridional trace (x, z), ref_real ---------------------- */
 
 /* nearest s > 0 with c(x^2 + Z^2) - 2Z = 0, Z = z - z0, on the vertex branch */
-static long double surf_hit(long double c, long double z0, long double x, long double z,
-                            long double dx, long double dz)
+static ref_real surf_hit(ref_real c, ref_real z0, ref_real x, ref_real z,
+                         ref_real dx, ref_real dz)
 {
-    long double Z = z - z0;
-    long double A = c, B = c * (x * dx + Z * dz) - dz, C = c * (x * x + Z * Z) - 2 * Z;
-    long double r[2];
+    ref_real Z = z - z0;
+    ref_real A = c, B = c * (x * dx + Z * dz) - dz, C = c * (x * x + Z * Z) - 2 * Z;
+    ref_real r[2];
     int nr = 0;
     if (A == 0) {
         r[nr++] = -C / (2 * B);
     } else {
-        long double disc = B * B - A * C;
+        ref_real disc = B * B - A * C;
         if (disc < 0)
             return -1;
-        long double q = -(B + copysignl(sqrtl(disc), B));
+        ref_real q = -(B + ref_copysign(ref_sqrt(disc), B));
         r[nr++] = q / A;
         r[nr++] = C / q;
     }
-    long double best = -1;
+    ref_real best = -1;
     for (int i = 0; i < nr; i++) {
-        long double zz = z + r[i] * dz - z0;
-        if (r[i] > 1e-12L && c * zz < 1 && (best < 0 || r[i] < best))
+        ref_real zz = z + r[i] * dz - z0;
+        if (r[i] > REF(1e-12) && c * zz < 1 && (best < 0 || r[i] < best))
             best = r[i];
     }
     return best;
 }
 
-static void surf_refract(long double c, long double z0, long double x, long double z, long double *dx,
-                         long double *dz, long double n1, long double n2)
+static void surf_refract(ref_real c, ref_real z0, ref_real x, ref_real z, ref_real *dx,
+                         ref_real *dz, ref_real n1, ref_real n2)
 {
-    long double nx = c * x, nz = c * (z - z0) - 1;
-    long double L = sqrtl(nx * nx + nz * nz);
+    ref_real nx = c * x, nz = c * (z - z0) - 1;
+    ref_real L = ref_sqrt(nx * nx + nz * nz);
     nx /= L;
     nz /= L;
-    long double ci = -(*dx * nx + *dz * nz);
+    ref_real ci = -(*dx * nx + *dz * nz);
     if (ci < 0) {
         nx = -nx;
         nz = -nz;
         ci = -ci;
     }
-    long double eta = n1 / n2;
-    long double ct = sqrtl(1 - eta * eta * (1 - ci * ci));
-    long double ex = eta * *dx + (eta * ci - ct) * nx;
-    long double ez = eta * *dz + (eta * ci - ct) * nz;
-    long double l = sqrtl(ex * ex + ez * ez);
+    ref_real eta = n1 / n2;
+    ref_real ct = ref_sqrt(1 - eta * eta * (1 - ci * ci));
+    ref_real ex = eta * *dx + (eta * ci - ct) * nx;
+    ref_real ez = eta * *dz + (eta * ci - ct) * nz;
+    ref_real l = ref_sqrt(ex * ex + ez * ez);
     *dx = ex / l;
     *dz = ez / l;
 }
 
 /* Axis crossing z of a ray parallel to the axis at height h, entering
  * from the front (back = 0, travelling +z) or from behind (travelling -z). */
-static long double exact_crossing(double R1, double R2, double t, double n, double h, int back)
+static ref_real exact_crossing(double R1, double R2, double t, double n, double h, int back)
 {
-    long double c[2] = {curv(R1), curv(R2)}, z0[2] = {0, t};
-    long double x = h, z = back ? t + 10.0L : -10.0L, dx = 0, dz = back ? -1 : 1;
+    ref_real c[2] = {curv(R1), curv(R2)}, z0[2] = {0, t};
+    ref_real x = h, z = back ? t + REF(10.0) : -REF(10.0), dx = 0, dz = back ? -1 : 1;
     for (int k = 0; k < 2; k++) {
         int s = back ? 1 - k : k;
-        long double d = surf_hit(c[s], z0[s], x, z, dx, dz);
+        ref_real d = surf_hit(c[s], z0[s], x, z, dx, dz);
         x += d * dx;
         z += d * dz;
         if (k == 0)
-            surf_refract(c[s], z0[s], x, z, &dx, &dz, 1.0L, n);
+            surf_refract(c[s], z0[s], x, z, &dx, &dz, REF(1.0), n);
         else
-            surf_refract(c[s], z0[s], x, z, &dx, &dz, n, 1.0L);
+            surf_refract(c[s], z0[s], x, z, &dx, &dz, n, REF(1.0));
     }
     return z - x * dz / dx;
 }

@@ -12,9 +12,10 @@
  *   Schlick     R0 + (1-R0)(1-c)^5, R0 = ((n1-n2)/(n1+n2))^2, c = cos of
  *               the angle on the less dense side.
  *
- * The reference values of the pure functions are computed in long double
- * from the same double cos_i the library receives, so the measured error
- * is the library's own rounding.  Relative tolerance 1e-12 (double math
+ * The reference values of the pure functions are computed in ref_real
+ * (binary128 where available, see ref_real.h) from the same double cos_i
+ * the library receives, so the measured error is the library's own
+ * rounding.  Relative tolerance 1e-12 (double math
  * of a few operations is ~1e-15; near the critical angle ct is
  * ill-conditioned in st^2, which costs up to ~1e-14).  The identities the
  * brief states at 1e-15 are checked at 1e-15.
@@ -35,6 +36,7 @@
 #include "check.h"
 #include "fresnel.h"
 #include "lensprim.h"
+#include "ref_real.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -42,46 +44,46 @@
 static const double NGLASS = 1.5168;
 
 /* ---------------------------------------------------------------- */
-/* My closed forms (long double)                                     */
+/* My closed forms (ref_real)                                        */
 /* ---------------------------------------------------------------- */
 
 typedef struct ref_fresnel {
     int tir;
-    long double ct, rs, rp, Ts, Tp;
+    ref_real ct, rs, rp, Ts, Tp;
 } ref_fresnel;
 
 static void ref_eval(double cos_i, double n1d, double n2d, ref_fresnel *m)
 {
-    long double ci = cos_i, n1 = n1d, n2 = n2d;
-    long double si2 = (1.0L - ci) * (1.0L + ci);
-    long double st2 = (n1 / n2) * (n1 / n2) * si2;
+    ref_real ci = cos_i, n1 = n1d, n2 = n2d;
+    ref_real si2 = (REF(1.0) - ci) * (REF(1.0) + ci);
+    ref_real st2 = (n1 / n2) * (n1 / n2) * si2;
     memset(m, 0, sizeof *m);
-    if (st2 > 1.0L) {
+    if (st2 > REF(1.0)) {
         m->tir = 1;
         return;
     }
-    long double ct = sqrtl(1.0L - st2);
+    ref_real ct = ref_sqrt(REF(1.0) - st2);
     m->ct = ct;
     m->rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
     m->rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
-    long double tsa = 2.0L * n1 * ci / (n1 * ci + n2 * ct);
-    long double tpa = 2.0L * n1 * ci / (n2 * ci + n1 * ct);
-    long double g = (ci > 0.0L) ? n2 * ct / (n1 * ci) : 0.0L;
+    ref_real tsa = REF(2.0) * n1 * ci / (n1 * ci + n2 * ct);
+    ref_real tpa = REF(2.0) * n1 * ci / (n2 * ci + n1 * ct);
+    ref_real g = (ci > REF(0.0)) ? n2 * ct / (n1 * ci) : REF(0.0);
     m->Ts = g * tsa * tsa;
     m->Tp = g * tpa * tpa;
 }
 
-static long double ref_schlick(double cos_i, double n1, double n2)
+static ref_real ref_schlick(double cos_i, double n1, double n2)
 {
     ref_fresnel m;
     ref_eval(cos_i, n1, n2, &m);
     if (m.tir)
-        return 1.0L;
-    long double r0 = ((long double)n1 - n2) / ((long double)n1 + n2);
+        return REF(1.0);
+    ref_real r0 = ((ref_real)n1 - n2) / ((ref_real)n1 + n2);
     r0 *= r0;
-    long double c = (n1 <= n2) ? (long double)cos_i : m.ct;
-    long double x = 1.0L - c;
-    return r0 + (1.0L - r0) * x * x * x * x * x;
+    ref_real c = (n1 <= n2) ? (ref_real)cos_i : m.ct;
+    ref_real x = REF(1.0) - c;
+    return r0 + (REF(1.0) - r0) * x * x * x * x * x;
 }
 
 /* ---------------------------------------------------------------- */
@@ -117,7 +119,7 @@ static void check_below_critical(double theta_deg, double n1, double n2)
     /* energy: R + T = 1 */
     CHECK_ABS(f.Rs + f.ts * f.ts, 1.0, 1e-15, "Rs+ts^2 %g deg %g->%g", theta_deg, n1, n2);
     CHECK_ABS(f.Rp + f.tp * f.tp, 1.0, 1e-15, "Rp+tp^2 %g deg %g->%g", theta_deg, n1, n2);
-    CHECK_REL(lp__fresnel_unpolarized(ci, n1, n2), (double)((m.rs * m.rs + m.rp * m.rp) / 2.0L),
+    CHECK_REL(lp__fresnel_unpolarized(ci, n1, n2), (double)((m.rs * m.rs + m.rp * m.rp) / REF(2.0)),
               1e-12, "unpolarized %g deg %g->%g", theta_deg, n1, n2);
     CHECK_REL(lp__schlick(ci, n1, n2), (double)ref_schlick(ci, n1, n2), 1e-12,
               "schlick %g deg %g->%g", theta_deg, n1, n2);
@@ -374,7 +376,7 @@ static void test_end_to_end(void)
              * angle, n1 > n2: Schlick uses cos of the transmitted angle,
              * which is cos th again; Fresnel's R is the same both ways. */
             double R = mode ? (double)ref_schlick(c, 1.0, NGLASS)
-                            : (double)((m.rs * m.rs + m.rp * m.rp) / 2.0L);
+                            : (double)((m.rs * m.rs + m.rp * m.rp) / REF(2.0));
             const lp_out_ray *r1 = only_ray(&res, 1, "unpolarized depth 1");
             if (r1)
                 CHECK_REL(r1->ray.intensity, R, 1e-12, "%s R at %d deg",

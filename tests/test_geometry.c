@@ -2,7 +2,7 @@
  * containment, bounds and self-intersection.
  *
  * Every expected value is computed here from closed-form geometry in
- * long double (a reference intersector of my own: spherical caps in the
+ * ref_real, binary128 where available (a reference intersector of my own: spherical caps in the
  * optical-design form c(x^2+y^2+z^2) - 2z = 0, a cylinder or cone rim),
  * never from the library.  Conventions from lensprim.h: front vertex at
  * z = 0, back vertex at z = t, R > 0 means the centre of curvature is at +z
@@ -22,6 +22,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 #include "lensprim.h"
+#include "ref_real.h"
 
 /* ------------------------------------------------------------------ */
 /* small helpers                                                       */
@@ -31,11 +32,11 @@
 
 /* A placement: world = P + e1*x + e2*y + A*z (A = the lens axis). */
 
-/* local -> world, in long double */
-/* world -> local, in long double */
+/* local -> world, in ref_real */
+/* world -> local, in ref_real */
 
 /* ------------------------------------------------------------------ */
-/* reference lens geometry, long double, local frame                   */
+/* reference lens geometry, ref_real, local frame                      */
 /* ------------------------------------------------------------------ */
 
 /* sag(h) = R - sign(R) sqrt(R^2 - h^2), written without cancellation:
@@ -118,11 +119,11 @@ static void test_accepts(void)
         double e = lp_lens_edge_thickness(lens);
         if (s->D2 == 0) {
             /* edge thickness t + sag2(h) - sag1(h), sag(h) = R - sign(R) sqrt(R^2 - h^2) */
-            long double h = s->D / 2.0L, want = s->t;
+            ref_real h = s->D / REF(2.0), want = s->t;
             if (!(s->R2 == 0 || isinf(s->R2)))
-                want += s->R2 - copysignl(1.0L, s->R2) * sqrtl((long double)s->R2 * s->R2 - h * h);
+                want += s->R2 - ref_copysign(REF(1.0), s->R2) * ref_sqrt((ref_real)s->R2 * s->R2 - h * h);
             if (!(s->R1 == 0 || isinf(s->R1)))
-                want -= s->R1 - copysignl(1.0L, s->R1) * sqrtl((long double)s->R1 * s->R1 - h * h);
+                want -= s->R1 - ref_copysign(REF(1.0), s->R1) * ref_sqrt((ref_real)s->R1 * s->R1 - h * h);
             if (is_knife(s))
                 CHECK_ABS(e, 0.0, 1e-12 * s->t, "%s edge thickness (knife edge)", s->name);
             else
@@ -227,7 +228,7 @@ static void check_hit(const char *what, const lp_lens *lens, const ref_lens *L, 
 {
     /* reference computed from the same (double) world ray */
     lv3 O = fl_point(f, Ow), d = lnorm(fl_dir(f, dw));
-    ref_hit r = ref_intersect(L, O, d, 0.0L);
+    ref_hit r = ref_intersect(L, O, d, REF(0.0));
     lp_hit h;
     memset(&h, 0, sizeof h);
     int got = lp_lens_intersect(lens, Ow, dw, 0.0, INFINITY, &h);
@@ -235,7 +236,8 @@ static void check_hit(const char *what, const lp_lens *lens, const ref_lens *L, 
         CHECK(!got, "%s: library hit (surface %d) where the reference misses", what, h.surface);
         return;
     }
-    CHECK(got, "%s: library misses, reference hits surface %d at s=%.17Lg", what, r.surf, r.s);
+    CHECK(got, "%s: library misses, reference hits surface %d at s=%.17g", what, r.surf,
+          (double)r.s);
     if (!got)
         return;
     lv3 pw = fw_point(f, r.p), nw = fw_dir(f, r.n);
@@ -253,10 +255,10 @@ static void check_hit(const char *what, const lp_lens *lens, const ref_lens *L, 
 /* An origin in front of / behind the lens aimed at a point of a cap. */
 static void cap_target(const ref_lens *L, int back, double frac, double phi, lv3 *target)
 {
-    long double a = back ? L->a2 : L->a1;
-    long double r = frac * a;
-    long double z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
-    *target = L3(r * cosl(phi), r * sinl(phi), z);
+    ref_real a = back ? L->a2 : L->a1;
+    ref_real r = frac * a;
+    ref_real z = back ? L->t + rsag(L->c2, r) : rsag(L->c1, r);
+    *target = L3(r * ref_cos(phi), r * ref_sin(phi), z);
 }
 
 static void test_axial_and_parallel(void)
@@ -304,8 +306,8 @@ static void test_axial_and_parallel(void)
                 if (!g)
                     continue;
                 /* the sag at this exact (double) height */
-                long double hgt = sqrtl((long double)O.x * O.x + (long double)O.y * O.y);
-                long double z = back ? L.t + rsag(L.c2, hgt) : rsag(L.c1, hgt);
+                ref_real hgt = ref_sqrt((ref_real)O.x * O.x + (ref_real)O.y * O.y);
+                ref_real z = back ? L.t + rsag(L.c2, hgt) : rsag(L.c1, hgt);
                 CHECK_ABS(hh.point.z, (double)z, 1e-12 * L.size, "%s: parallel hit z = %ssag(%g)",
                           s->name, back ? "t + " : "", (double)hgt);
                 CHECK(hh.surface == (back ? LP_SURFACE_BACK : LP_SURFACE_FRONT),
@@ -326,7 +328,7 @@ static void test_radii_accuracy(void)
             double R = radii[i];
             double D = fmin(25.0, 1.6 * R);
             double R1 = sign * R, R2 = -sign * R;
-            long double sagm = isinf(R) ? 0.0L : rsag(1.0L / R, D / 2);
+            ref_real sagm = isinf(R) ? REF(0.0) : rsag(REF(1.0) / R, D / 2);
             double t = sign > 0 ? (double)(2 * sagm) + 0.2 * D : 0.1 * D;
             ref_lens L;
             ref_init(&L, R1, R2, t, D, 0);
@@ -349,7 +351,7 @@ static void test_radii_accuracy(void)
                 } while (fabs(dir.z) < 0.5);
                 if ((dir.z < 0) != back)
                     dir = vscale(dir, -1);
-                lp_vec3 O = lto(lsub(T, lscale(lfrom(dir), 2.0L * L.size)));
+                lp_vec3 O = lto(lsub(T, lscale(lfrom(dir), REF(2.0) * L.size)));
                 check_hit(name, lens, &L, &f, O, dir, 1e-12);
             }
             lp_lens_destroy(lens);
@@ -394,15 +396,16 @@ static void test_tangent(void)
         lv3 P, dir;
         if (!back) {
             /* front centre (0,0,50): P = C + 50*(sin a, -cos a) */
-            P = L3(50 * sinl(a) * cosl(phi), 50 * sinl(a) * sinl(phi), 50 - 50 * cosl(a));
+            P = L3(50 * ref_sin(a) * ref_cos(phi), 50 * ref_sin(a) * ref_sin(phi), 50 - 50 * ref_cos(a));
             /* (cos a, sin a) in (r, z) is perpendicular to the radius
              * (sin a, -cos a): the ray arrives from smaller r and z */
-            dir = L3(cosl(a) * cosl(phi), cosl(a) * sinl(phi), sinl(a));
+            dir = L3(ref_cos(a) * ref_cos(phi), ref_cos(a) * ref_sin(phi), ref_sin(a));
         } else {
-            P = L3(50 * sinl(a) * cosl(phi), 50 * sinl(a) * sinl(phi), 8 - 50 + 50 * cosl(a));
-            dir = L3(cosl(a) * cosl(phi), cosl(a) * sinl(phi), -sinl(a));
+            P = L3(50 * ref_sin(a) * ref_cos(phi), 50 * ref_sin(a) * ref_sin(phi),
+                   8 - 50 + 50 * ref_cos(a));
+            dir = L3(ref_cos(a) * ref_cos(phi), ref_cos(a) * ref_sin(phi), -ref_sin(a));
         }
-        lp_vec3 O = lto(lsub(P, lscale(dir, 20.0L)));
+        lp_vec3 O = lto(lsub(P, lscale(dir, REF(20.0))));
         lp_vec3 d = lto(dir);
         for (int j = -1; j <= 1; j++) {
             lp_vec3 Oj = vadd(O, vscale(V(cos(phi), sin(phi), 0), j * 1e-9));
@@ -472,7 +475,7 @@ static void test_placement(void)
                 dl.z = -dl.z;
             if (fabs(dl.z) < 0.2)
                 continue;
-            lp_vec3 Ol = lto(lsub(T, lscale(lfrom(dl), 2.0L * L.size)));
+            lp_vec3 Ol = lto(lsub(T, lscale(lfrom(dl), REF(2.0) * L.size)));
             /* world ray: the local ray transformed */
             lp_vec3 Ow = lto(fw_point(&f, lfrom(Ol))), dw = lto(fw_dir(&f, lfrom(dl)));
             lp_hit h0, hw;
@@ -510,8 +513,8 @@ static void test_contains_bounds(void)
         lp_lens *lens = make_lens(s->R1, s->R2, s->t, s->D, s->D2, &f, NULL);
         if (!lens)
             continue;
-        long double zmin = fminl(0.0L, L.zf), zmax = fmaxl(L.t, L.zb);
-        long double rmax = fmaxl(L.a1, L.a2);
+        ref_real zmin = ref_fmin(REF(0.0), L.zf), zmax = ref_fmax(L.t, L.zb);
+        ref_real rmax = ref_fmax(L.a1, L.a2);
         /* points on the axis */
         if (rep < (int)N_GOOD) {
             CHECK(lp_lens_contains(lens, V(0, 0, s->t / 2)), "%s: contains the centre", s->name);
@@ -528,15 +531,15 @@ static void test_contains_bounds(void)
         int n_in = 0, n_out = 0;
         for (int k = 0; k < 4000; k++) {
             lv3 p = L3(urange(-1.2, 1.2) * rmax, urange(-1.2, 1.2) * rmax,
-                       zmin - 0.2L * (zmax - zmin) + urand() * 1.4L * (zmax - zmin));
-            long double m;
+                       zmin - REF(0.2) * (zmax - zmin) + urand() * REF(1.4) * (zmax - zmin));
+            ref_real m;
             int want = ref_inside(&L, p, &m);
-            if (m < 1e-7L * L.size)
+            if (m < REF(1e-7) * L.size)
                 continue;
             lp_vec3 w = lto(fw_point(&f, p));
             int got = lp_lens_contains(lens, w);
-            CHECK(got == want, "%s: contains(local %.9Lg %.9Lg %.9Lg) = %d, want %d", s->name, p.x,
-                  p.y, p.z, got, want);
+            CHECK(got == want, "%s: contains(local %.9g %.9g %.9g) = %d, want %d", s->name,
+                  (double)p.x, (double)p.y, (double)p.z, got, want);
             if (want)
                 n_in++;
             else
@@ -552,20 +555,20 @@ static void test_contains_bounds(void)
         double slack = 1e-9 * L.size;
         int outside = 0;
         for (int k = 0; k < 3000; k++) {
-            long double phi = urange(0, 2 * M_PI);
+            ref_real phi = urange(0, 2 * M_PI);
             lv3 p;
             int which = k % 3;
             if (which < 2) {
-                long double a = which ? L.a2 : L.a1, r = sqrtl(urand()) * a;
+                ref_real a = which ? L.a2 : L.a1, r = ref_sqrt(urand()) * a;
                 if (k % 10 == 0)
                     r = a;
-                long double z = which ? L.t + rsag(L.c2, r) : rsag(L.c1, r);
-                p = L3(r * cosl(phi), r * sinl(phi), z);
+                ref_real z = which ? L.t + rsag(L.c2, r) : rsag(L.c1, r);
+                p = L3(r * ref_cos(phi), r * ref_sin(phi), z);
             } else {
-                long double u = urand();
-                long double z = L.zf + u * (L.zb - L.zf);
-                long double r = L.a1 + u * (L.a2 - L.a1);
-                p = L3(r * cosl(phi), r * sinl(phi), z);
+                ref_real u = urand();
+                ref_real z = L.zf + u * (L.zb - L.zf);
+                ref_real r = L.a1 + u * (L.a2 - L.a1);
+                p = L3(r * ref_cos(phi), r * ref_sin(phi), z);
             }
             lv3 w = fw_point(&f, p);
             if (w.x < lo.x - slack || w.x > hi.x + slack || w.y < lo.y - slack ||
@@ -585,11 +588,11 @@ static void test_contains_bounds(void)
     lp_lens *lens = make_lens(50, -50, 8, 30, 20, NULL, NULL);
     if (lens) {
         for (int k = 0; k < 200; k++) {
-            long double u = urange(0.05, 0.95), phi = urange(0, 2 * M_PI);
-            long double z = L.zf + u * (L.zb - L.zf), r = L.a1 + u * (L.a2 - L.a1);
-            lv3 n = lnorm(L3(cosl(phi), sinl(phi), -L.k)); /* outward cone normal */
-            lv3 p = L3(r * cosl(phi), r * sinl(phi), z);
-            lv3 pin = ladd(p, lscale(n, -1e-6L)), pout = ladd(p, lscale(n, 1e-6L));
+            ref_real u = urange(0.05, 0.95), phi = urange(0, 2 * M_PI);
+            ref_real z = L.zf + u * (L.zb - L.zf), r = L.a1 + u * (L.a2 - L.a1);
+            lv3 n = lnorm(L3(ref_cos(phi), ref_sin(phi), -L.k)); /* outward cone normal */
+            lv3 p = L3(r * ref_cos(phi), r * ref_sin(phi), z);
+            lv3 pin = ladd(p, lscale(n, -REF(1e-6))), pout = ladd(p, lscale(n, REF(1e-6)));
             CHECK(lp_lens_contains(lens, lto(pin)), "cone: point 1e-6 inside the cone is inside");
             CHECK(!lp_lens_contains(lens, lto(pout)), "cone: point 1e-6 outside the cone is outside");
         }
@@ -620,7 +623,7 @@ static void test_no_self_hit(void)
                 dl.z = -dl.z;
             if (fabs(dl.z) < 0.2)
                 continue;
-            lp_vec3 Ow = lto(fw_point(&f, lsub(T, lscale(lfrom(dl), 2.0L * L.size))));
+            lp_vec3 Ow = lto(fw_point(&f, lsub(T, lscale(lfrom(dl), REF(2.0) * L.size))));
             lp_vec3 dw = lto(fw_dir(&f, lfrom(dl)));
             lp_hit h;
             if (!lp_lens_intersect(lens, Ow, dw, 0.0, INFINITY, &h) || h.surface == LP_SURFACE_RIM)
@@ -629,14 +632,14 @@ static void test_no_self_hit(void)
             lv3 nl = fl_dir(&f, h.normal);
             lv3 d = lnorm(fl_dir(&f, dw));
             lv3 pl = fl_point(&f, h.point);
-            long double ci = -ldot(d, nl);
-            if (ci < 1e-3L)
+            ref_real ci = -ldot(d, nl);
+            if (ci < REF(1e-3))
                 continue;
-            long double eta = 1.0L / n, ct = sqrtl(1.0L - eta * eta * (1.0L - ci * ci));
+            ref_real eta = REF(1.0) / n, ct = ref_sqrt(REF(1.0) - eta * eta * (REF(1.0) - ci * ci));
             lv3 dt = lnorm(ladd(lscale(d, eta), lscale(nl, eta * ci - ct)));
             lp_vec3 dtw = lto(fw_dir(&f, dt));
-            lv3 de = ladd(d, lscale(nl, 2.0L * ci)); /* external reflection */
-            ref_hit r = ref_intersect(&L, pl, dt, 1e-9L);
+            lv3 de = ladd(d, lscale(nl, REF(2.0) * ci)); /* external reflection */
+            ref_hit r = ref_intersect(&L, pl, dt, REF(1e-9));
             /* (a) the property itself: t_min = 0 from the hit point must
              * not return the hit point again */
             lp_hit h2;
@@ -659,7 +662,7 @@ static void test_no_self_hit(void)
                       "%s: exit point of the refracted ray", s->name);
             /* internal reflection from the exit point */
             lv3 n2 = fl_dir(&f, h2b.normal);
-            lv3 dr = ladd(dt, lscale(n2, -2.0L * ldot(dt, n2)));
+            lv3 dr = ladd(dt, lscale(n2, -REF(2.0) * ldot(dt, n2)));
             lp_hit h3;
             int g3 = lp_lens_intersect(lens, h2b.point, lto(fw_dir(&f, dr)), 0.0, INFINITY, &h3);
             CHECK(g3 && h3.t > 1e-9, "%s: internal reflection re-hit (t_min 0): found %d t=%g", s->name,
@@ -667,7 +670,7 @@ static void test_no_self_hit(void)
             g3 = lp_lens_intersect(lens, h2b.point, lto(fw_dir(&f, dr)), 1e-9, INFINITY, &h3);
             CHECK(g3, "%s: internally reflected ray (t_min 1e-9) finds no surface", s->name);
             ref_hit r3 = ref_intersect(&L, fl_point(&f, h2b.point), lnorm(fl_dir(&f, lto(fw_dir(&f, dr)))),
-                                       1e-9L);
+                                       REF(1e-9));
             if (g3 && r3.surf >= 0)
                 CHECK_ABS((double)llen(lsub(lfrom(h3.point), fw_point(&f, r3.p))) / L.size, 0.0, 1e-11,
                           "%s: next point after the internal reflection", s->name);
@@ -686,7 +689,7 @@ int main(void)
     test_placement();
     test_contains_bounds();
     test_no_self_hit();
-    printf("test_geometry: worst hit point error / lens size vs long double reference %.3g, "
+    printf("test_geometry: worst hit point error / lens size vs " REF_NAME " reference %.3g, "
            "worst normal error %.3g, worst placed-vs-unplaced %.3g\n",
            worst_hit_err, worst_normal_err, worst_place_err);
     return check_finish("test_geometry");

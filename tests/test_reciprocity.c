@@ -12,12 +12,12 @@
  * (1e-10 relative) and the same complex field sum over TIR parts of
  * sqrt(I) vp exp(i Phi), Phi = 2 pi op/lambda - pi kphi + phase (1e-8).
  * Both are also compared with the exact field computed here: the view
- * chain traced in long double, and the light carried back along it by
- * Fresnel's amplitude equations (Born & Wolf, p = k x s basis, complex
- * TIR coefficients for exp(-i w t)), with n*s propagation phase and
- * Beer-Lambert absorption of a hand-made glass (tau flat in lambda).
- * fresnel and schlick modes compare intensities, also with the node
- * product of (Rs+Rp)/2 or Schlick's law written here.
+ * chain traced in ref_real (binary128 where available), and the light
+ * carried back along it by Fresnel's amplitude equations (Born & Wolf,
+ * p = k x s basis, complex TIR coefficients for exp(-i w t)), with n*s
+ * propagation phase and Beer-Lambert absorption of a hand-made glass
+ * (tau flat in lambda).  fresnel and schlick modes compare intensities,
+ * also with the node product of (Rs+Rp)/2 or Schlick's law written here.
  *
  * Paths that are ill-conditioned in double precision are not compared
  * (and counted): a node within 1e-6 x size of a cap's edge circle, an
@@ -39,6 +39,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 #include "lensprim.h"
+#include "ref_real.h"
 
 /* ------------------------------------------------------------------ */
 /* small helpers                                                       */
@@ -52,7 +53,7 @@
 
 #include <complex.h>
 
-typedef long double complex lcx;
+typedef ref_complex lcx;
 typedef struct { lcx x, y, z; } cv3;
 
 static cv3 cv_from(lv3 a) { cv3 r = {a.x, a.y, a.z}; return r; }
@@ -64,9 +65,9 @@ static cv3 cv_comb(lcx s, lv3 a, lcx p, lv3 b)
 }
 static cv3 cv_scale(cv3 a, lcx s) { cv3 r = {a.x * s, a.y * s, a.z * s}; return r; }
 static cv3 cv_add(cv3 a, cv3 b) { cv3 r = {a.x + b.x, a.y + b.y, a.z + b.z}; return r; }
-static long double cv_norm2(cv3 a)
+static ref_real cv_norm2(cv3 a)
 {
-    return creall(a.x * conjl(a.x) + a.y * conjl(a.y) + a.z * conjl(a.z));
+    return ref_creal(a.x * ref_conj(a.x) + a.y * ref_conj(a.y) + a.z * ref_conj(a.z));
 }
 
 /* Snell: d hits a surface with (either-sided) normal n from index n1 into
@@ -77,16 +78,16 @@ static long double cv_norm2(cv3 a)
 typedef struct {
     int tir;
     lcx rs, rp;
-    long double ts, tp; /* power-normalized: ts^2 = 1 - |rs|^2 */
-    long double Rs, Rp, ct;
+    ref_real ts, tp; /* power-normalized: ts^2 = 1 - |rs|^2 */
+    ref_real Rs, Rp, ct;
 } fres;
 
-static fres fresnel(long double ci, long double n1, long double n2)
+static fres fresnel(ref_real ci, ref_real n1, ref_real n2)
 {
     fres f;
-    long double st2 = (n1 / n2) * (n1 / n2) * (1 - ci) * (1 + ci);
+    ref_real st2 = (n1 / n2) * (n1 / n2) * (1 - ci) * (1 + ci);
     if (st2 >= 1) {
-        long double q = sqrtl(n1 * n1 * (1 - ci) * (1 + ci) - n2 * n2);
+        ref_real q = ref_sqrt(n1 * n1 * (1 - ci) * (1 + ci) - n2 * n2);
         f.tir = 1;
         f.rs = (n1 * ci - I * q) / (n1 * ci + I * q);
         f.rp = (n2 * n2 * ci - I * n1 * q) / (n2 * n2 * ci + I * n1 * q);
@@ -95,42 +96,42 @@ static fres fresnel(long double ci, long double n1, long double n2)
         f.ct = -1;
         return f;
     }
-    long double ct = sqrtl(1 - st2);
-    long double rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
-    long double rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
+    ref_real ct = ref_sqrt(1 - st2);
+    ref_real rs = (n1 * ci - n2 * ct) / (n1 * ci + n2 * ct);
+    ref_real rp = (n2 * ci - n1 * ct) / (n2 * ci + n1 * ct);
     f.tir = 0;
     f.rs = rs;
     f.rp = rp;
     f.Rs = rs * rs;
     f.Rp = rp * rp;
-    f.ts = sqrtl(1 - f.Rs);
-    f.tp = sqrtl(1 - f.Rp);
+    f.ts = ref_sqrt(1 - f.Rs);
+    f.tp = ref_sqrt(1 - f.Rp);
     f.ct = ct;
     return f;
 }
 
 /* Reflectance of a node for a mode's unpolarized law (fresnel, schlick). */
-static long double mode_R(lp_mode mode, long double ci, long double n1, long double n2)
+static ref_real mode_R(lp_mode mode, ref_real ci, ref_real n1, ref_real n2)
 {
     fres f = fresnel(ci, n1, n2);
     if (f.tir)
         return 1;
     if (mode == LP_MODE_SCHLICK) {
-        long double R0 = ((n1 - n2) / (n1 + n2)) * ((n1 - n2) / (n1 + n2));
-        long double c = n1 <= n2 ? ci : f.ct;
-        return R0 + (1 - R0) * powl(1 - c, 5);
+        ref_real R0 = ((n1 - n2) / (n1 + n2)) * ((n1 - n2) / (n1 + n2));
+        ref_real c = n1 <= n2 ? ci : f.ct;
+        return R0 + (1 - R0) * ref_pow(1 - c, 5);
     }
     return (f.Rs + f.Rp) / 2;
 }
 
 /* One node in the direction of light: field E on k_in leaves along k_out
  * (reflected or transmitted) at a surface with normal n. */
-static cv3 jones_node(cv3 E, lv3 k_in, lv3 k_out, lv3 n, long double n1, long double n2, int reflect)
+static cv3 jones_node(cv3 E, lv3 k_in, lv3 k_out, lv3 n, ref_real n1, ref_real n2, int reflect)
 {
-    long double ci = fabsl(ldot(k_in, n));
+    ref_real ci = ref_fabs(ldot(k_in, n));
     lv3 s = lcross(k_in, n);
-    if (llen(s) < 1e-12L) { /* normal incidence: any s */
-        lv3 h = fabsl(k_in.x) < 0.6L ? L3(1, 0, 0) : L3(0, 1, 0);
+    if (llen(s) < REF(1e-12)) { /* normal incidence: any s */
+        lv3 h = ref_fabs(k_in.x) < REF(0.6) ? L3(1, 0, 0) : L3(0, 1, 0);
         s = lcross(k_in, h);
     }
     s = lnorm(s);
@@ -143,7 +144,7 @@ static cv3 jones_node(cv3 E, lv3 k_in, lv3 k_out, lv3 n, long double n1, long do
 }
 
 /* ------------------------------------------------------------------ */
-/* the view ray's chain through the lens (long double reference)       */
+/* the view ray's chain through the lens (ref_real reference)          */
 /* ------------------------------------------------------------------ */
 
 #define MAXN 24
@@ -151,16 +152,16 @@ typedef struct {
     int n;                                   /* cap nodes 1..n */
     lv3 p[MAXN + 2], nrm[MAXN + 2], din[MAXN + 2], drefl[MAXN + 2], dtran[MAXN + 2];
     int surf[MAXN + 2], tir[MAXN + 2], good[MAXN + 2];
-    long double seg[MAXN + 2];               /* internal length node k-1 -> k */
-    long double cosi[MAXN + 2];
+    ref_real seg[MAXN + 2];                  /* internal length node k-1 -> k */
+    ref_real cosi[MAXN + 2];
     int rim_depth;                           /* node index of the rim, 0 none */
     int leak;
 } chain;
 
-static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O, lv3 d, chain *c)
+static void build_chain(const ref_lens *L, ref_real ng, ref_real nm, lv3 O, lv3 d, chain *c)
 {
     memset(c, 0, sizeof *c);
-    ref_hit h = ref_intersect(L, O, d, 0.0L);
+    ref_hit h = ref_intersect(L, O, d, REF(0.0));
     if (h.surf < 0)
         return;
     if (h.surf == LP_SURFACE_RIM) {
@@ -168,26 +169,26 @@ static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O
         return;
     }
     lv3 dir = d;
-    long double n1 = nm, n2 = ng;
-    long double edge_m = 1e-6L * L->size;
+    ref_real n1 = nm, n2 = ng;
+    ref_real edge_m = REF(1e-6) * L->size;
     for (int k = 1; k <= MAXN; k++) {
         c->n = k;
         c->p[k] = h.p;
         c->nrm[k] = h.n;
         c->surf[k] = h.surf;
         c->din[k] = dir;
-        long double ci = fabsl(ldot(dir, h.n));
+        ref_real ci = ref_fabs(ldot(dir, h.n));
         c->cosi[k] = ci;
         c->drefl[k] = lreflect(dir, h.n);
         c->tir[k] = !lrefract(dir, h.n, n1, n2, &c->dtran[k]);
         /* conditioning: away from the cap's edge circle, not grazing, not
          * near the critical angle */
-        long double a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
-        long double r = sqrtl(h.p.x * h.p.x + h.p.y * h.p.y);
-        long double x = (n1 / n2) * sqrtl((1 - ci) * (1 + ci)); /* sin of refraction */
-        int good = r < a - edge_m && ci > 0.02L && fabsl(x - 1) > 1e-3L;
+        ref_real a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
+        ref_real r = ref_sqrt(h.p.x * h.p.x + h.p.y * h.p.y);
+        ref_real x = (n1 / n2) * ref_sqrt((1 - ci) * (1 + ci)); /* sin of refraction */
+        int good = r < a - edge_m && ci > REF(0.02) && ref_fabs(x - 1) > REF(1e-3);
         if (!c->tir[k])
-            good = good && sqrtl((1 - x) * (1 + x)) > 0.02L;
+            good = good && ref_sqrt((1 - x) * (1 + x)) > REF(0.02);
         c->good[k] = good;
         lv3 next;
         if (k == 1) {
@@ -199,7 +200,7 @@ static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O
         } else {
             next = c->drefl[k];
         }
-        h = ref_intersect(L, h.p, next, 1e-9L * L->size);
+        h = ref_intersect(L, h.p, next, REF(1e-9) * L->size);
         if (h.surf < 0) {
             c->leak = 1;
             return;
@@ -215,10 +216,10 @@ static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O
 
 /* Follow light along the reverse of the chain from node k to node 1,
  * starting at S along u0; 0 if it takes another route. */
-static int follow(const ref_lens *L, const chain *c, int k, long double ng, long double nm, lv3 S,
+static int follow(const ref_lens *L, const chain *c, int k, ref_real ng, ref_real nm, lv3 S,
                   lv3 u0, lv3 *exit_p, lv3 *exit_d)
 {
-    ref_hit h = ref_intersect(L, S, u0, 0.0L);
+    ref_hit h = ref_intersect(L, S, u0, REF(0.0));
     if (h.surf != c->surf[k])
         return 0;
     if (k == 1) {
@@ -231,7 +232,7 @@ static int follow(const ref_lens *L, const chain *c, int k, long double ng, long
         return 0;
     lv3 p = h.p;
     for (int j = k - 1; j >= 1; j--) {
-        h = ref_intersect(L, p, dir, 1e-9L * L->size);
+        h = ref_intersect(L, p, dir, REF(1e-9) * L->size);
         if (h.surf != c->surf[j])
             return 0;
         p = h.p;
@@ -246,16 +247,16 @@ static int follow(const ref_lens *L, const chain *c, int k, long double ng, long
 }
 
 /* optical path inside the lens along query k's path */
-static long double chain_op(const chain *c, int k, long double ng)
+static ref_real chain_op(const chain *c, int k, ref_real ng)
 {
-    long double L = 0;
+    ref_real L = 0;
     for (int j = 2; j <= k; j++)
         L += c->seg[j];
     return ng * L;
 }
-static long double chain_len(const chain *c, int k)
+static ref_real chain_len(const chain *c, int k)
 {
-    long double L = 0;
+    ref_real L = 0;
     for (int j = 2; j <= k; j++)
         L += c->seg[j];
     return L;
@@ -264,7 +265,7 @@ static long double chain_len(const chain *c, int k)
 /* The exact field leaving at the view ray's entry point along -d for
  * light arriving along -(query k dir) with field vp (unit, real), without
  * the propagation phase and absorption. */
-static cv3 chain_jones(const chain *c, int k, long double ng, long double nm, lv3 vp, lv3 view_d)
+static cv3 chain_jones(const chain *c, int k, ref_real ng, ref_real nm, lv3 vp, lv3 view_d)
 {
     cv3 E = cv_from(vp);
     if (k == 1)
@@ -278,17 +279,17 @@ static cv3 chain_jones(const chain *c, int k, long double ng, long double nm, lv
 
 /* unpolarized (or polarized bound) power transmittance of query k's path,
  * without absorption */
-static long double chain_power(const chain *c, int k, long double ng, long double nm, lp_mode mode,
-                               int bound)
+static ref_real chain_power(const chain *c, int k, ref_real ng, ref_real nm, lp_mode mode,
+                            int bound)
 {
-    long double P = 1;
+    ref_real P = 1;
     for (int j = 1; j <= k; j++) {
-        long double n1 = j == 1 ? nm : ng, n2 = j == 1 ? ng : nm;
+        ref_real n1 = j == 1 ? nm : ng, n2 = j == 1 ? ng : nm;
         int reflect = (k == 1) || (j > 1 && j < k);
-        long double R;
+        ref_real R;
         if (bound) {
             fres f = fresnel(c->cosi[j], n1, n2);
-            R = reflect ? fmaxl(f.Rs, f.Rp) : fminl(f.Rs, f.Rp);
+            R = reflect ? ref_fmax(f.Rs, f.Rp) : ref_fmin(f.Rs, f.Rp);
         } else {
             R = mode_R(mode, c->cosi[j], n1, n2);
         }
@@ -324,33 +325,33 @@ static lv3 rand_perp(lv3 u)
     do {
         v = lfrom(rand_unit());
         v = lsub(v, lscale(u, ldot(v, u)));
-    } while (llen(v) < 0.1L);
+    } while (llen(v) < REF(0.1));
     return lnorm(v);
 }
 
 /* field sum of a set of rays, phase relative to op_ref (mm), corrected to
  * the reference exit point E along the ray (first order, Malus-Dupin) */
-static cv3 field_sum(const lp_out_ray *const *rays, int n, const frame *f, long double op_ref,
-                     long double lambda_mm, long double nm, lv3 E_ref, long double *op_out)
+static cv3 field_sum(const lp_out_ray *const *rays, int n, const frame *f, ref_real op_ref,
+                     ref_real lambda_mm, ref_real nm, lv3 E_ref, ref_real *op_out)
 {
     cv3 sum = {0, 0, 0};
     for (int i = 0; i < n; i++) {
         const lp_ray *r = &rays[i]->ray;
         lv3 o = fl_point(f, r->origin), d = fl_dir(f, r->dir);
-        long double op = r->op + nm * ldot(lsub(E_ref, o), d);
+        ref_real op = r->op + nm * ldot(lsub(E_ref, o), d);
         if (op_out)
             *op_out = op;
-        long double phi = 2 * M_PI * (op - op_ref) / lambda_mm - M_PI * r->kphi + r->phase;
-        lcx a = sqrtl((long double)r->intensity) * cexpl(I * phi);
+        ref_real phi = 2 * REF_PI * (op - op_ref) / lambda_mm - REF_PI * r->kphi + r->phase;
+        lcx a = ref_sqrt((ref_real)r->intensity) * ref_cexp(I * phi);
         sum = cv_add(sum, cv_scale(cv_from(fl_dir(f, r->vp)), a));
     }
     return sum;
 }
 
-static long double cv_dist(cv3 a, cv3 b)
+static ref_real cv_dist(cv3 a, cv3 b)
 {
     cv3 d = {a.x - b.x, a.y - b.y, a.z - b.z};
-    return sqrtl(cv_norm2(d));
+    return ref_sqrt(cv_norm2(d));
 }
 
 static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
@@ -358,10 +359,10 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
     rng_state = SEED + (uint64_t)li * 0x9E3779B97F4A7C15ULL + (uint64_t)mode;
     rshape s;
     random_shape(&s);
-    long double ng = urange(1.3, 2.0), nm = (sm64() & 1) ? 1.0 : urange(1.0, 1.4);
+    ref_real ng = urange(1.3, 2.0), nm = (sm64() & 1) ? 1.0 : urange(1.0, 1.4);
     lp_glass glass, medium;
     lp_glass_init_constant(&glass, (double)ng);
-    long double alpha = 0;
+    ref_real alpha = 0;
     if (sm64() & 1) { /* absorbing: tau = 0.5..0.99 over 10 mm, flat in lambda */
         double tau = urange(0.5, 0.99);
         glass.n_tau = 2;
@@ -369,7 +370,7 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
         glass.tau_lambda_nm[1] = 900;
         glass.tau[0] = glass.tau[1] = tau;
         glass.tau_thickness_mm = 10;
-        alpha = -logl(tau) / 10;
+        alpha = -ref_log(tau) / 10;
         lp_error gerr;
         CHECK(lp_glass_check(&glass, &gerr) == LP_OK, "hand-made absorbing glass: %s", gerr.message);
     }
@@ -391,18 +392,18 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
         /* a view ray entering a random cap point from outside */
         int back = (int)(sm64() & 1);
         lv3 T = random_surface_point(&L, back);
-        if (sqrtl(T.x * T.x + T.y * T.y) > 0.9L * (back ? L.a2 : L.a1))
+        if (ref_sqrt(T.x * T.x + T.y * T.y) > REF(0.9) * (back ? L.a2 : L.a1))
             continue;
         lv3 nT = lnorm(back ? lscale(L3(L.c2 * T.x, L.c2 * T.y, L.c2 * (T.z - L.t) - 1), -1)
                             : L3(L.c1 * T.x, L.c1 * T.y, L.c1 * T.z - 1));
         lv3 d;
         do {
             d = lfrom(rand_unit());
-        } while (ldot(d, nT) > -0.2L);
-        lp_vec3 Ow = lto(fw_point(&f, lsub(T, lscale(d, 2.0L * L.size))));
+        } while (ldot(d, nT) > -REF(0.2));
+        lp_vec3 Ow = lto(fw_point(&f, lsub(T, lscale(d, REF(2.0) * L.size))));
         lp_vec3 dw = lto(fw_dir(&f, d));
         double lambda = urange(380, 780);
-        long double lambda_mm = lambda * 1e-6L;
+        ref_real lambda_mm = lambda * REF(1e-6);
         /* the reference chain from exactly the double view ray */
         lv3 O = fl_point(&f, Ow);
         d = lnorm(fl_dir(&f, dw));
@@ -459,35 +460,36 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
             CHECK(q->surface == c.surf[k], "%s: query surface %d want %d", ctx, q->surface, c.surf[k]);
             CHECK(q->kind == (k == 1 || c.surf[k] == c.surf[1] ? LP_KIND_REFLECT : LP_KIND_TRANSMIT),
                   "%s: query kind %d", ctx, (int)q->kind);
-            long double op_ref = chain_op(&c, k, ng);
-            long double absorb = expl(-alpha * chain_len(&c, k));
+            ref_real op_ref = chain_op(&c, k, ng);
+            ref_real absorb = ref_exp(-alpha * chain_len(&c, k));
             double tol_op = 1e-8 * (double)lambda_mm / (2 * M_PI);
             CHECK_ABS(q->op, (double)op_ref, tol_op, "%s: query op (phase-equivalent 1e-8 rad)", ctx);
-            long double P_bound = chain_power(&c, k, ng, nm, mode, mode == LP_MODE_POLARIZED) * absorb;
+            ref_real P_bound = chain_power(&c, k, ng, nm, mode, mode == LP_MODE_POLARIZED) * absorb;
             CHECK_REL(q->bound, (double)P_bound, 1e-10, "%s: query bound vs Fresnel product", ctx);
 
             /* conditioning of the reverse path: angular amplification */
-            long double s_off = 1e-3L * L.size;
-            ref_hit back_hit = ref_intersect(&L, Qref, uref, 1e-9L * L.size);
+            ref_real s_off = REF(1e-3) * L.size;
+            ref_hit back_hit = ref_intersect(&L, Qref, uref, REF(1e-9) * L.size);
             if (back_hit.surf >= 0 && back_hit.s < 4 * s_off)
                 s_off = back_hit.s / 4;
             lv3 S0 = ladd(Qref, lscale(uref, s_off));
             lv3 ep, ed, ep1, ed1;
             int ok = follow(&L, &c, k, ng, nm, S0, lscale(uref, -1), &ep, &ed);
-            CHECK(ok && llen(lsub(ep, c.p[1])) < 1e-12L * L.size && llen(lsub(ed, lscale(d, -1))) < 1e-12L,
+            CHECK(ok && llen(lsub(ep, c.p[1])) < REF(1e-12) * L.size &&
+                      llen(lsub(ed, lscale(d, -1))) < REF(1e-12),
                   "%s: (test self-check) reverse path does not retrace the chain", ctx);
-            long double G = 0;
+            ref_real G = 0;
             lv3 e1 = rand_perp(uref), e2 = lnorm(lcross(uref, e1));
             for (int pj = 0; pj < 2 && ok; pj++) {
-                const long double dl = 1e-7L;
+                const ref_real dl = REF(1e-7);
                 lv3 u1 = lnorm(ladd(lscale(uref, -1), lscale(pj ? e2 : e1, dl)));
                 if (!follow(&L, &c, k, ng, nm, S0, u1, &ep1, &ed1)) {
                     G = INFINITY;
                     break;
                 }
-                G = fmaxl(G, llen(lsub(ed1, ed)) / dl);
+                G = ref_fmax(G, llen(lsub(ed1, ed)) / dl);
             }
-            if (!ok || G > 1e4L) {
+            if (!ok || G > REF(1e4)) {
                 S->skipped_sens++;
                 continue;
             }
@@ -568,7 +570,8 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
                 int match = 1;
                 for (int i = 0; i < nf; i++) {
                     lv3 o = fl_point(&f, fr[i]->ray.origin), dd = fl_dir(&f, fr[i]->ray.dir);
-                    match &= llen(lsub(o, c.p[1])) < 1e-7L * L.size && llen(lsub(dd, lscale(d, -1))) < 1e-7L;
+                    match &= llen(lsub(o, c.p[1])) < REF(1e-7) * L.size &&
+                             llen(lsub(dd, lscale(d, -1))) < REF(1e-7);
                     CHECK(fr[i]->kind == q->kind && fr[i]->surface == c.surf[1],
                           "%s: forward ray kind %d surface %d", ctx, (int)fr[i]->kind, fr[i]->surface);
                 }
@@ -577,37 +580,40 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
                 if (!match)
                     continue;
                 S->compared++;
-                long double Ib = bundle[b].intensity;
+                ref_real Ib = bundle[b].intensity;
                 if (mode == LP_MODE_POLARIZED) {
-                    long double opf = 0, opg = 0;
-                    long double op0 = op_ref + bundle[b].op;
+                    ref_real opf = 0, opg = 0;
+                    ref_real op0 = op_ref + bundle[b].op;
                     cv3 Ef = field_sum(fr, nf, &f, op0, lambda_mm, nm, c.p[1], &opf);
                     cv3 Eg = field_sum(gr, ng_, &f, op0, lambda_mm, nm, c.p[1], &opg);
                     /* the exact field, written here */
                     cv3 Er = chain_jones(&c, k, ng, nm, vp[b], d);
-                    lcx a = sqrtl(Ib) * sqrtl(absorb) * cexpl(I * (-M_PI * bundle[b].kphi + bundle[b].phase));
+                    lcx a = ref_sqrt(Ib) * ref_sqrt(absorb) *
+                            ref_cexp(I * (-REF_PI * bundle[b].kphi + bundle[b].phase));
                     Er = cv_scale(Er, a);
                     if (nf == 2 || ng_ == 2)
                         S->tir_paths++;
-                    long double sc = sqrtl(Ib);
+                    ref_real sc = ref_sqrt(Ib);
                     double dfb = (double)(cv_dist(Ef, Eg) / sc), dref = (double)(cv_dist(Eg, Er) / sc);
                     double dfr = (double)(cv_dist(Ef, Er) / sc);
                     CHECK_ABS(dfb, 0.0, 1e-8, "%s: bundle %d: field forward vs gathered", ctx, b);
                     CHECK_ABS(dref, 0.0, 1e-8, "%s: bundle %d: gathered field vs exact Jones field", ctx, b);
                     CHECK_ABS(dfr, 0.0, 1e-8, "%s: bundle %d: forward field vs exact Jones field", ctx, b);
-                    long double If = cv_norm2(Ef), Ig = cv_norm2(Eg), Ir = cv_norm2(Er);
+                    ref_real If = cv_norm2(Ef), Ig = cv_norm2(Eg), Ir = cv_norm2(Er);
                     CHECK_REL((double)Ig, (double)If, 1e-10, "%s: bundle %d: intensity gathered vs forward",
                               ctx, b);
                     CHECK_REL((double)Ig, (double)Ir, 1e-10, "%s: bundle %d: intensity vs exact", ctx, b);
-                    CHECK(Ig <= P_bound * Ib * (1 + 1e-10L), "%s: gathered intensity above the bound", ctx);
+                    CHECK(Ig <= P_bound * Ib * (1 + REF(1e-10)), "%s: gathered intensity above the bound",
+                          ctx);
                     CHECK_ABS((double)opg, (double)opf, tol_op, "%s: bundle %d: gathered op = forward op",
                               ctx, b);
                     CHECK_ABS((double)opg, (double)op0, tol_op, "%s: bundle %d: gathered op = bundle op + "
                               "path op", ctx, b);
                     S->worst_field_fb = fmax(S->worst_field_fb, dfb);
                     S->worst_field_ref = fmax(S->worst_field_ref, fmax(dref, dfr));
-                    S->worst_int_fb = fmax(S->worst_int_fb, (double)(fabsl(Ig - If) / fmaxl(If, 1e-300L)));
-                    S->worst_op = fmax(S->worst_op, (double)fabsl(opg - opf));
+                    S->worst_int_fb =
+                        fmax(S->worst_int_fb, (double)(ref_fabs(Ig - If) / ref_fmax(If, REF(1e-300))));
+                    S->worst_op = fmax(S->worst_op, (double)ref_fabs(opg - opf));
                     if (nf == 1 && ng_ == 1)
                         CHECK_REL(gr[0]->ray.intensity, fr[0]->ray.intensity, 1e-10,
                                   "%s: bundle %d: ray intensity gathered vs forward", ctx, b);
@@ -617,7 +623,7 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
                         If += fr[i]->ray.intensity;
                     for (int i = 0; i < ng_; i++)
                         Ig += gr[i]->ray.intensity;
-                    long double want = Ib * chain_power(&c, k, ng, nm, mode, 0) * absorb;
+                    ref_real want = Ib * chain_power(&c, k, ng, nm, mode, 0) * absorb;
                     CHECK_REL(Ig, If, 1e-10, "%s: bundle %d: intensity gathered vs forward", ctx, b);
                     CHECK_REL(Ig, (double)want, 1e-10, "%s: bundle %d: intensity vs %s product", ctx, b,
                               mode == LP_MODE_FRESNEL ? "Fresnel" : "Schlick");

@@ -7,7 +7,7 @@
  * runs into the cone is absorbed at depth 2 with exactly the refracted
  * power (1 - R) I (Fresnel computed here) and lp_backward_rim_depth = 2;
  * on random lenses lp_backward_rim_depth equals the depth at which the
- * reference chain (traced here in long double) meets the rim; rays
+ * reference chain (traced here in ref_real) meets the rim; rays
  * through the exact cap/rim edge circle give finite results and a
  * balanced bookkeeping.
  */
@@ -24,6 +24,7 @@
 #define M_PI 3.14159265358979323846
 #endif
 #include "lensprim.h"
+#include "ref_real.h"
 
 /* ------------------------------------------------------------------ */
 /* small helpers                                                       */
@@ -39,47 +40,47 @@ typedef struct {
     int n;                                   /* cap nodes 1..n */
     lv3 p[MAXN + 2], nrm[MAXN + 2], din[MAXN + 2], drefl[MAXN + 2], dtran[MAXN + 2];
     int surf[MAXN + 2], tir[MAXN + 2], good[MAXN + 2];
-    long double seg[MAXN + 2];               /* internal length node k-1 -> k */
-    long double cosi[MAXN + 2];
+    ref_real seg[MAXN + 2];                  /* internal length node k-1 -> k */
+    ref_real cosi[MAXN + 2];
     int rim_depth;                           /* node index of the rim, 0 none */
     lv3 rim_p;                               /* where the chain meets the rim */
-    long double rim_cos;                     /* |cos| of incidence on the rim */
+    ref_real rim_cos;                        /* |cos| of incidence on the rim */
     int leak;
 } chain;
 
-static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O, lv3 d, chain *c)
+static void build_chain(const ref_lens *L, ref_real ng, ref_real nm, lv3 O, lv3 d, chain *c)
 {
     memset(c, 0, sizeof *c);
-    ref_hit h = ref_intersect(L, O, d, 0.0L);
+    ref_hit h = ref_intersect(L, O, d, REF(0.0));
     if (h.surf < 0)
         return;
     if (h.surf == LP_SURFACE_RIM) {
         c->rim_depth = 1;
         c->rim_p = h.p;
-        c->rim_cos = fabsl(ldot(d, h.n));
+        c->rim_cos = ref_fabs(ldot(d, h.n));
         return;
     }
     lv3 dir = d;
-    long double n1 = nm, n2 = ng;
-    long double edge_m = 1e-6L * L->size;
+    ref_real n1 = nm, n2 = ng;
+    ref_real edge_m = REF(1e-6) * L->size;
     for (int k = 1; k <= MAXN; k++) {
         c->n = k;
         c->p[k] = h.p;
         c->nrm[k] = h.n;
         c->surf[k] = h.surf;
         c->din[k] = dir;
-        long double ci = fabsl(ldot(dir, h.n));
+        ref_real ci = ref_fabs(ldot(dir, h.n));
         c->cosi[k] = ci;
         c->drefl[k] = lreflect(dir, h.n);
         c->tir[k] = !lrefract(dir, h.n, n1, n2, &c->dtran[k]);
         /* conditioning: away from the cap's edge circle, not grazing, not
          * near the critical angle */
-        long double a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
-        long double r = sqrtl(h.p.x * h.p.x + h.p.y * h.p.y);
-        long double x = (n1 / n2) * sqrtl((1 - ci) * (1 + ci)); /* sin of refraction */
-        int good = r < a - edge_m && ci > 0.02L && fabsl(x - 1) > 1e-3L;
+        ref_real a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
+        ref_real r = ref_sqrt(h.p.x * h.p.x + h.p.y * h.p.y);
+        ref_real x = (n1 / n2) * ref_sqrt((1 - ci) * (1 + ci)); /* sin of refraction */
+        int good = r < a - edge_m && ci > REF(0.02) && ref_fabs(x - 1) > REF(1e-3);
         if (!c->tir[k])
-            good = good && sqrtl((1 - x) * (1 + x)) > 0.02L;
+            good = good && ref_sqrt((1 - x) * (1 + x)) > REF(0.02);
         c->good[k] = good;
         lv3 next;
         if (k == 1) {
@@ -91,7 +92,7 @@ static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O
         } else {
             next = c->drefl[k];
         }
-        h = ref_intersect(L, h.p, next, 1e-9L * L->size);
+        h = ref_intersect(L, h.p, next, REF(1e-9) * L->size);
         if (h.surf < 0) {
             c->leak = 1;
             return;
@@ -99,7 +100,7 @@ static void build_chain(const ref_lens *L, long double ng, long double nm, lv3 O
         if (h.surf == LP_SURFACE_RIM) {
             c->rim_depth = k + 1;
             c->rim_p = h.p;
-            c->rim_cos = fabsl(ldot(next, h.n));
+            c->rim_cos = ref_fabs(ldot(next, h.n));
             return;
         }
         c->seg[k + 1] = h.s;
@@ -158,7 +159,7 @@ static void check_balance(const lp_result *r, const char *what)
 /* outward normal of the rim (cylinder or cone) at a local point */
 static lv3 rim_normal(const ref_lens *L, lv3 p)
 {
-    long double r = L->a1 + L->k * (p.z - L->zf);
+    ref_real r = L->a1 + L->k * (p.z - L->zf);
     return lnorm(L3(p.x, p.y, -r * L->k));
 }
 
@@ -184,17 +185,17 @@ static void test_rim_from_outside(void)
         lp_result_init(&res);
         int n_done = 0;
         for (int k = 0; k < 200; k++) {
-            long double u = urange(0.02, 0.98), phi = urange(0, 2 * M_PI);
-            long double z = L.zf + u * (L.zb - L.zf), r = L.a1 + u * (L.a2 - L.a1);
-            lv3 P = L3(r * cosl(phi), r * sinl(phi), z);
+            ref_real u = urange(0.02, 0.98), phi = urange(0, 2 * M_PI);
+            ref_real z = L.zf + u * (L.zb - L.zf), r = L.a1 + u * (L.a2 - L.a1);
+            lv3 P = L3(r * ref_cos(phi), r * ref_sin(phi), z);
             lv3 n = rim_normal(&L, P);
             lv3 d;
             do {
                 d = lfrom(rand_unit());
-            } while (ldot(d, n) > -0.1L);
-            lv3 O = lsub(P, lscale(d, 3.0L * L.size));
-            ref_hit h = ref_intersect(&L, O, d, 0.0L);
-            if (h.surf != LP_SURFACE_RIM || llen(lsub(h.p, P)) > 1e-9L * L.size)
+            } while (ldot(d, n) > -REF(0.1));
+            lv3 O = lsub(P, lscale(d, REF(3.0) * L.size));
+            ref_hit h = ref_intersect(&L, O, d, REF(0.0));
+            if (h.surf != LP_SURFACE_RIM || llen(lsub(h.p, P)) > REF(1e-9) * L.size)
                 continue; /* a concave cap's lip is in the way */
             snprintf(ctx, sizeof ctx, "[rim from outside: shape %zu ray %d]", si, k);
             lp_vec3 Ow = lto(fw_point(&f, O)), dw = lto(fw_dir(&f, d));
@@ -253,20 +254,22 @@ static void test_cone_contains(void)
     CHECK_ABS((double)L.zf, 50 - sqrt(2275.0), 1e-13, "cone lens: front edge z");
     CHECK_ABS((double)L.zb, 8 - 50 + sqrt(2400.0), 1e-13, "cone lens: back edge z");
     for (int k = 0; k < 300; k++) {
-        long double u = urange(0.02, 0.98), phi = urange(0, 2 * M_PI);
-        long double z = L.zf + u * (L.zb - L.zf), r = L.a1 + u * (L.a2 - L.a1);
-        lv3 P = L3(r * cosl(phi), r * sinl(phi), z);
+        ref_real u = urange(0.02, 0.98), phi = urange(0, 2 * M_PI);
+        ref_real z = L.zf + u * (L.zb - L.zf), r = L.a1 + u * (L.a2 - L.a1);
+        lv3 P = L3(r * ref_cos(phi), r * ref_sin(phi), z);
         lv3 n = rim_normal(&L, P);
         for (int j = 1; j <= 3; j++) {
-            long double e = powl(10, -2 * j); /* 1e-2, 1e-4, 1e-6 mm */
-            CHECK(lp_lens_contains(lens, lto(ladd(P, lscale(n, -e)))), "cone: %Lg inside is inside", e);
-            CHECK(!lp_lens_contains(lens, lto(ladd(P, lscale(n, e)))), "cone: %Lg outside is outside", e);
+            ref_real e = ref_pow(10, -2 * j); /* 1e-2, 1e-4, 1e-6 mm */
+            CHECK(lp_lens_contains(lens, lto(ladd(P, lscale(n, -e)))), "cone: %g inside is inside",
+                  (double)e);
+            CHECK(!lp_lens_contains(lens, lto(ladd(P, lscale(n, e)))), "cone: %g outside is outside",
+                  (double)e);
         }
         /* points inside the old cylinder r < 15 but outside the cone */
-        long double rc = r + 0.5L * (L.a1 - r);
-        if (rc > r + 0.05L)
-            CHECK(!lp_lens_contains(lens, lto(L3(rc * cosl(phi), rc * sinl(phi), z))),
-                  "cone: r=%Lg at z=%Lg (cone radius %Lg) is outside", rc, z, r);
+        ref_real rc = r + REF(0.5) * (L.a1 - r);
+        if (rc > r + REF(0.05))
+            CHECK(!lp_lens_contains(lens, lto(L3(rc * ref_cos(phi), rc * ref_sin(phi), z))),
+                  "cone: r=%g at z=%g (cone radius %g) is outside", (double)rc, (double)z, (double)r);
     }
     lp_lens_destroy(lens);
 }
@@ -288,23 +291,24 @@ static void test_refracted_into_rim(void)
     lp_backward_create(&bw, NULL);
     int found = 0;
     for (int k = 0; k < 4000 && found < 60; k++) {
-        long double r = urange(12.5, 14.8), phi = urange(0, 2 * M_PI);
-        lv3 P = L3(r * cosl(phi), r * sinl(phi), rsag(L.c1, r));
+        ref_real r = urange(12.5, 14.8), phi = urange(0, 2 * M_PI);
+        lv3 P = L3(r * ref_cos(phi), r * ref_sin(phi), rsag(L.c1, r));
         lv3 nP = lnorm(L3(L.c1 * P.x, L.c1 * P.y, L.c1 * P.z - 1)); /* outward front normal */
         /* incoming from the front, tilted outward */
-        lv3 d = lnorm(L3(urange(0, 1.2) * cosl(phi), urange(0, 1.2) * sinl(phi) + urange(-0.2, 0.2), 1));
-        long double ci = -ldot(d, nP);
-        if (ci < 0.1L)
+        lv3 d = lnorm(L3(urange(0, 1.2) * ref_cos(phi), urange(0, 1.2) * ref_sin(phi) + urange(-0.2, 0.2),
+                         1));
+        ref_real ci = -ldot(d, nP);
+        if (ci < REF(0.1))
             continue;
         lv3 dt;
-        if (!lrefract(d, nP, 1.0L, n, &dt))
+        if (!lrefract(d, nP, REF(1.0), n, &dt))
             continue;
-        lv3 O = lsub(P, lscale(d, 3.0L * L.size));
-        ref_hit h0 = ref_intersect(&L, O, d, 0.0L);
-        if (h0.surf != LP_SURFACE_FRONT || llen(lsub(h0.p, P)) > 1e-9L * L.size)
+        lv3 O = lsub(P, lscale(d, REF(3.0) * L.size));
+        ref_hit h0 = ref_intersect(&L, O, d, REF(0.0));
+        if (h0.surf != LP_SURFACE_FRONT || llen(lsub(h0.p, P)) > REF(1e-9) * L.size)
             continue;
-        ref_hit h = ref_intersect(&L, P, dt, 1e-9L * L.size);
-        if (h.surf != LP_SURFACE_RIM || h.p.z - L.zf < 0.05L || L.zb - h.p.z < 0.05L)
+        ref_hit h = ref_intersect(&L, P, dt, REF(1e-9) * L.size);
+        if (h.surf != LP_SURFACE_RIM || h.p.z - L.zf < REF(0.05) || L.zb - h.p.z < REF(0.05))
             continue;
         found++;
         snprintf(ctx, sizeof ctx, "[refracted into the rim, case %d]", found);
@@ -318,24 +322,24 @@ static void test_refracted_into_rim(void)
         CHECK(st == LP_OK, "%s: status", ctx);
         check_balance(&res, ctx);
         /* the external reflectance at the entry, computed here */
-        long double Rs, Rp;
+        ref_real Rs, Rp;
         {
-            long double ct = sqrtl(1 - (1 - ci * ci) / (n * n));
-            long double rs = (ci - n * ct) / (ci + n * ct), rp = (n * ci - ct) / (n * ci + ct);
+            ref_real ct = ref_sqrt(1 - (1 - ci * ci) / (n * n));
+            ref_real rs = (ci - n * ct) / (ci + n * ct), rp = (n * ci - ct) / (n * ci + ct);
             Rs = rs * rs;
             Rp = rp * rp;
-            long double R;
+            ref_real R;
             if (args.mode == LP_MODE_POLARIZED) {
                 lv3 v = fl_dir(&f, vnorm(in.vp));
                 v = lnorm(lsub(v, lscale(d, ldot(v, d))));
                 lv3 sx = lnorm(lcross(d, nP));
-                long double as2 = ldot(v, sx) * ldot(v, sx);
+                ref_real as2 = ldot(v, sx) * ldot(v, sx);
                 R = Rs * as2 + Rp * (1 - as2);
             } else if (args.mode == LP_MODE_FRESNEL) {
                 R = (Rs + Rp) / 2;
             } else {
-                long double R0 = powl((1 - n) / (1 + n), 2);
-                R = R0 + (1 - R0) * powl(1 - ci, 5);
+                ref_real R0 = ref_pow((1 - n) / (1 + n), 2);
+                R = R0 + (1 - R0) * ref_pow(1 - ci, 5);
             }
             CHECK_REL(res.absorbed_rim, (double)((1 - R) * in.intensity), 1e-10,
                       "%s: absorbed_rim = the refracted power (1 - R) I", ctx);
@@ -378,7 +382,7 @@ static void test_rim_depth_random(void)
         rng_state = SEED + (uint64_t)li * 0x9E3779B97F4A7C15ULL;
         rshape s;
         random_shape(&s);
-        long double ng = urange(1.3, 2.0), nm = (sm64() & 1) ? 1.0 : urange(1.0, 1.25);
+        ref_real ng = urange(1.3, 2.0), nm = (sm64() & 1) ? 1.0 : urange(1.0, 1.25);
         lp_glass glass, medium;
         lp_glass_init_constant(&glass, (double)ng);
         lp_glass_init_constant(&medium, (double)nm);
@@ -392,7 +396,7 @@ static void test_rim_depth_random(void)
             int which = (int)(sm64() % 5);
             lv3 T = random_surface_point(&L, which < 2 ? 0 : (which < 4 ? 1 : 2));
             lv3 d = lfrom(rand_unit());
-            lv3 O = lsub(T, lscale(d, 2.0L * L.size));
+            lv3 O = lsub(T, lscale(d, REF(2.0) * L.size));
             lp_vec3 Ow = lto(fw_point(&f, O)), dw = lto(fw_dir(&f, d));
             O = fl_point(&f, Ow);
             d = lnorm(fl_dir(&f, dw));
@@ -411,8 +415,8 @@ static void test_rim_depth_random(void)
             for (int k = 1; k <= last; k++)
                 good = good && c.good[k];
             if (c.rim_depth && c.rim_depth <= args.max_depth) {
-                long double m = 1e-6L * L.size;
-                good = good && c.rim_p.z - L.zf > m && L.zb - c.rim_p.z > m && c.rim_cos > 0.02L;
+                ref_real m = REF(1e-6) * L.size;
+                good = good && c.rim_p.z - L.zf > m && L.zb - c.rim_p.z > m && c.rim_cos > REF(0.02);
             }
             if (c.rim_depth == args.max_depth + 1)
                 good = 0; /* the rim just past the depth limit: not specified */
@@ -480,12 +484,12 @@ static void test_edge_circle(void)
         for (int k = 0; k < 400; k++) {
             int back = k & 1;
             double phi = (k % 8 == 0) ? 0.0 : urange(0, 2 * M_PI);
-            long double a = back ? L.a2 : L.a1;
-            lv3 P = L3(a * cosl(phi), a * sinl(phi), back ? L.zb : L.zf);
+            ref_real a = back ? L.a2 : L.a1;
+            lv3 P = L3(a * ref_cos(phi), a * ref_sin(phi), back ? L.zb : L.zf);
             if (k % 8 == 0)
                 P.y = 0; /* exactly on the x axis */
             lv3 d = lfrom(rand_unit());
-            lv3 O = lsub(P, lscale(d, 3.0L * L.size));
+            lv3 O = lsub(P, lscale(d, REF(3.0) * L.size));
             lp_vec3 Ow = lto(fw_point(&f, O)), dw = lto(fw_dir(&f, d));
             snprintf(ctx, sizeof ctx, "[edge circle: shape %zu ray %d]", si, k);
             lp_hit h;

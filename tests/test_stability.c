@@ -13,9 +13,10 @@
  *
  * Every expected value is written here from closed-form physics (Snell,
  * Born & Wolf's Fresnel amplitudes, the plate's ray chain, Schott's
- * Sellmeier coefficients) in long double, evaluated for the double ray
- * exactly as the library receives it, or from the long-double reference
- * lens of lens_reference.h traced here (ref_chain); never from the code
+ * Sellmeier coefficients) in ref_real (ref_real.h: binary128 where
+ * available), evaluated for the double ray exactly as the library
+ * receives it, or from the ref_real reference lens of lens_reference.h
+ * traced here (ref_chain); never from the code
  * under test.  Each tolerance is derived in its section's comment from an
  * error estimate; eps is DBL_EPSILON = 2.2e-16.  Each section prints its
  * measured worst errors (and error/tolerance where the tolerance is a
@@ -65,6 +66,7 @@
 #include "check.h"
 #include "fresnel.h"
 #include "lensprim.h"
+#include "ref_real.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -72,19 +74,18 @@
 
 #include "lens_reference.h"
 
-typedef long double LD;
-#define PI_L 3.141592653589793238462643383279502884L
+typedef ref_real LD; /* the references' number type (ref_real.h) */
 #define EPS DBL_EPSILON
 
 /* ------------------------------------------------------------------ */
-/* Closed-form Fresnel, long double                                    */
+/* Closed-form Fresnel, ref_real                                       */
 /* ------------------------------------------------------------------ */
 
 typedef struct {
     int tir;
     LD w2;               /* cos^2 t = 1 - (n1/n2)^2 si^2 (< 0 under TIR) */
     LD ct, q;            /* cos t (below), q (TIR) */
-    long double complex rs, rp;
+    ref_complex rs, rp;
     LD Rs, Rp, Ts, Tp;   /* powers; Ts = Tp = 0 under TIR */
     LD ts, tp;           /* power-normalized transmission amplitudes */
 } ref_fr;
@@ -96,36 +97,36 @@ static ref_fr fr_eval(LD ci, LD si2, LD n1, LD n2)
     ref_fr f;
     memset(&f, 0, sizeof f);
     LD eta = n1 / n2;
-    f.w2 = 1.0L - eta * eta * si2;
-    if (f.w2 < 0.0L) {
+    f.w2 = REF(1.0) - eta * eta * si2;
+    if (f.w2 < REF(0.0)) {
         f.tir = 1;
-        f.q = sqrtl(n1 * n1 * si2 - n2 * n2);
-        long double complex a = n1 * ci, b = I * f.q;
-        long double complex ap = n2 * n2 * ci, bp = I * n1 * f.q;
+        f.q = ref_sqrt(n1 * n1 * si2 - n2 * n2);
+        ref_complex a = n1 * ci, b = I * f.q;
+        ref_complex ap = n2 * n2 * ci, bp = I * n1 * f.q;
         f.rs = (a - b) / (a + b);
         f.rp = (ap - bp) / (ap + bp);
-        f.Rs = f.Rp = 1.0L;
+        f.Rs = f.Rp = REF(1.0);
         return f;
     }
-    f.ct = sqrtl(f.w2);
+    f.ct = ref_sqrt(f.w2);
     LD a = n1 * ci, b = n2 * f.ct, c = n2 * ci, d = n1 * f.ct;
     f.rs = (a - b) / (a + b);
     f.rp = (c - d) / (c + d);
-    f.Rs = creall(f.rs) * creall(f.rs);
-    f.Rp = creall(f.rp) * creall(f.rp);
-    f.Ts = 4.0L * a * b / ((a + b) * (a + b));
-    f.Tp = 4.0L * c * d / ((c + d) * (c + d));
-    f.ts = sqrtl(f.Ts);
-    f.tp = sqrtl(f.Tp);
+    f.Rs = ref_creal(f.rs) * ref_creal(f.rs);
+    f.Rp = ref_creal(f.rp) * ref_creal(f.rp);
+    f.Ts = REF(4.0) * a * b / ((a + b) * (a + b));
+    f.Tp = REF(4.0) * c * d / ((c + d) * (c + d));
+    f.ts = ref_sqrt(f.Ts);
+    f.tp = ref_sqrt(f.Tp);
     return f;
 }
 
 /* incidence cosine and sine^2 of the double direction d on a plane of
- * unit normal +-z, in long double */
+ * unit normal +-z, in ref_real */
 static void dir_angles(lp_vec3 d, LD *ci, LD *si2)
 {
     LD x = d.x, y = d.y, z = d.z, n2 = x * x + y * y + z * z;
-    *ci = fabsl(z) / sqrtl(n2);
+    *ci = ref_fabs(z) / ref_sqrt(n2);
     *si2 = (x * x + y * y) / n2;
 }
 
@@ -133,40 +134,41 @@ static void dir_angles(lp_vec3 d, LD *ci, LD *si2)
 /* Complex fields                                                      */
 /* ------------------------------------------------------------------ */
 
-typedef struct { long double complex x, y, z; } cv;
+typedef struct { ref_complex x, y, z; } cv;
 
 static cv cv_zero(void)
 {
     cv e = {0, 0, 0};
     return e;
 }
-static cv cv_axpy(cv e, long double complex a, lv3 u)
+static cv cv_axpy(cv e, ref_complex a, lv3 u)
 {
     e.x += a * u.x;
     e.y += a * u.y;
     e.z += a * u.z;
     return e;
 }
-static cv cv_scale(cv e, long double complex a)
+static cv cv_scale(cv e, ref_complex a)
 {
     e.x *= a;
     e.y *= a;
     e.z *= a;
     return e;
 }
-static long double complex cv_dot(cv e, lv3 u) { return e.x * u.x + e.y * u.y + e.z * u.z; }
+static ref_complex cv_dot(cv e, lv3 u) { return e.x * u.x + e.y * u.y + e.z * u.z; }
 static LD cv_dist(cv a, cv b)
 {
-    long double complex dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
-    return sqrtl(creall(dx * conjl(dx) + dy * conjl(dy) + dz * conjl(dz)));
+    ref_complex dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z;
+    return ref_sqrt(ref_creal(dx * ref_conj(dx) + dy * ref_conj(dy) + dz * ref_conj(dz)));
 }
 
 /* The field of one ray, sqrt(I) vp exp(i Phi); with_op 0 leaves the
  * propagation phase 2 pi op/lambda out. */
 static cv ray_field(const lp_ray *r, int with_op)
 {
-    LD phi = (with_op ? 2.0L * PI_L * r->op / r->lambda_nm : 0.0L) - PI_L * r->kphi + r->phase;
-    long double complex amp = sqrtl((LD)r->intensity) * cexpl(I * phi);
+    LD phi = (with_op ? REF(2.0) * REF_PI * r->op / r->lambda_nm : REF(0.0)) - REF_PI * r->kphi +
+             r->phase;
+    ref_complex amp = ref_sqrt((LD)r->intensity) * ref_cexp(I * phi);
     return cv_axpy(cv_zero(), amp, lfrom(r->vp));
 }
 
@@ -215,15 +217,15 @@ static const lp_out_ray *first_at_depth(const lp_result *res, int depth)
 static ref_fr node_fields(lv3 d, lv3 nrm, cv E, LD n1, LD n2, cv *refl, cv *trans, lv3 *rdir,
                           lv3 *tdir)
 {
-    lv3 m = ldot(d, nrm) < 0 ? nrm : lscale(nrm, -1.0L); /* toward the incident side */
+    lv3 m = ldot(d, nrm) < 0 ? nrm : lscale(nrm, -REF(1.0)); /* toward the incident side */
     LD ci = -ldot(d, m);
     lv3 sx = lcross(d, m);
     LD sl = llen(sx);
     LD si2 = sl * sl; /* |d x m|^2 = sin^2 i, no cancellation */
-    if (ci > 1.0L)
-        ci = 1.0L;
+    if (ci > REF(1.0))
+        ci = REF(1.0);
     ref_fr f = fr_eval(ci, si2, n1, n2);
-    lv3 r = ladd(d, lscale(m, 2.0L * ci));
+    lv3 r = ladd(d, lscale(m, REF(2.0) * ci));
     lv3 t = L3(0, 0, 0);
     if (!f.tir) {
         LD eta = n1 / n2;
@@ -233,16 +235,16 @@ static ref_fr node_fields(lv3 d, lv3 nrm, cv E, LD n1, LD n2, cv *refl, cv *tran
         *rdir = r;
     if (tdir)
         *tdir = t;
-    if (sl == 0.0L) {
+    if (sl == REF(0.0)) {
         if (refl)
             *refl = cv_scale(E, f.rs);
         if (trans)
             *trans = cv_scale(E, f.ts);
         return f;
     }
-    lv3 s = lscale(sx, 1.0L / sl);
+    lv3 s = lscale(sx, REF(1.0) / sl);
     lv3 pi = lcross(d, s), pr = lcross(r, s);
-    long double complex es = cv_dot(E, s), ep = cv_dot(E, pi);
+    ref_complex es = cv_dot(E, s), ep = cv_dot(E, pi);
     if (refl)
         *refl = cv_axpy(cv_axpy(cv_zero(), f.rs * es, s), f.rp * ep, pr);
     if (trans) {
@@ -369,7 +371,7 @@ static void sections_restore(void)
 
 static double relerr(double got, LD want)
 {
-    return (double)(fabsl((LD)got - want) / (want != 0.0L ? fabsl(want) : 1.0L));
+    return (double)(ref_fabs((LD)got - want) / (want != REF(0.0) ? ref_fabs(want) : REF(1.0)));
 }
 
 static lp_lens *make_lens(double R1, double R2, double t, double D, double D2, double n_glass,
@@ -422,7 +424,7 @@ static lp_status trace(const lp_lens *lens, const lp_ray *in, int max_depth, lp_
 }
 
 /* ------------------------------------------------------------------ */
-/* The reference chain: the forward ray tree traced in long double      */
+/* The reference chain: the forward ray tree traced in ref_real         */
 /* ------------------------------------------------------------------ */
 
 /* The same tree the library builds (lensprim.h: the entry node reflects
@@ -445,7 +447,7 @@ static void ref_chain(const ref_lens *L, lv3 O, lv3 d, cv E, LD ng, LD nm, int m
 {
     memset(out, 0, sizeof *out);
     d = lnorm(d);
-    ref_hit h = ref_intersect(L, O, d, 0.0L);
+    ref_hit h = ref_intersect(L, O, d, REF(0.0));
     if (h.surf < 0)
         return;
     if (h.surf == LP_SURFACE_RIM) {
@@ -466,13 +468,13 @@ static void ref_chain(const ref_lens *L, lv3 O, lv3 d, cv E, LD ng, LD nm, int m
     E = Et;
     d = tdir;
     lv3 p = h.p;
-    LD op = 0.0L, minseg = INFINITY;
+    LD op = REF(0.0), minseg = INFINITY;
     for (int depth = 1; depth < max_depth;) {
-        h = ref_intersect(L, p, d, 1e-16L * L->size);
+        h = ref_intersect(L, p, d, REF(1e-16) * L->size);
         if (h.surf < 0)
             return;
         op += ng * h.s;
-        minseg = fminl(minseg, h.s);
+        minseg = ref_fmin(minseg, h.s);
         if (h.surf == LP_SURFACE_RIM) {
             out->rim_depth = depth + 1;
             return;
@@ -518,8 +520,8 @@ static void ref_chain(const ref_lens *L, lv3 O, lv3 d, cv E, LD ng, LD nm, int m
 static void test_grazing(void)
 {
     const double n = 1.5, t = 10.0, D = 100.0;
-    const LD ct_inf = sqrtl(1.0L - 1.0L / ((LD)n * n));
-    const LD lim[2] = {4.0L / (n * ct_inf), 4.0L * n / ct_inf};
+    const LD ct_inf = ref_sqrt(REF(1.0) - REF(1.0) / ((LD)n * n));
+    const LD lim[2] = {REF(4.0) / (n * ct_inf), REF(4.0) * n / ct_inf};
     lp_lens *lens = make_lens(0.0, 0.0, t, D, 0.0, n, 1.0);
     if (!lens)
         return;
@@ -532,8 +534,8 @@ static void test_grazing(void)
         for (int k = 1; k <= 12; k++) {
             char what[96];
             snprintf(what, sizeof what, "grazing %s 90deg-1e-%d", pn, k);
-            LD delta = powl(10.0L, -k);
-            lp_vec3 d = V((double)cosl(delta), 0.0, (double)sinl(delta));
+            LD delta = ref_pow(REF(10.0), -k);
+            lp_vec3 d = V((double)ref_cos(delta), 0.0, (double)ref_sin(delta));
             lp_vec3 vp = pol ? V(-d.z, 0.0, d.x) : V(0.0, 1.0, 0.0);
             lp_vec3 o = vscale(d, -1000.0);
             lp_ray in = make_ray(o, d, vp, 550.0, 1.0);
@@ -541,7 +543,7 @@ static void test_grazing(void)
                 continue;
             LD ci, si2;
             dir_angles(d, &ci, &si2);
-            ref_fr f = fr_eval(ci, si2, 1.0L, n);
+            ref_fr f = fr_eval(ci, si2, REF(1.0), n);
             LD R = pol ? f.Rp : f.Rs, T = pol ? f.Tp : f.Ts;
             if (k == 12) {
                 /* the rim's slack takes it (see the header) */
@@ -597,7 +599,7 @@ static void test_grazing(void)
         lp__fresnel lf;
         lp__fresnel_eval(ci, 1.0, n, &lf);
         LD cil = ci;
-        ref_fr f = fr_eval(cil, (1.0L - cil) * (1.0L + cil), 1.0L, n);
+        ref_fr f = fr_eval(cil, (REF(1.0) - cil) * (REF(1.0) + cil), REF(1.0), n);
         CHECK(!lf.tir, "node cos 1e-%d: no TIR from air", k);
         CHECK_REL(lf.Rs, (double)f.Rs, 1e-14, "node cos 1e-%d: Rs", k);
         CHECK_REL(lf.Rp, (double)f.Rp, 1e-14, "node cos 1e-%d: Rp", k);
@@ -641,8 +643,8 @@ static void test_grazing(void)
  */
 static void test_critical(void)
 {
-    const LD n1 = 1.5L, n2 = 1.0L;
-    const LD thc = asinl(n2 / n1);
+    const LD n1 = REF(1.5), n2 = REF(1.0);
+    const LD thc = ref_asin(n2 / n1);
     lp_lens *bubble = make_lens(0.0, 0.0, 10.0, 100.0, 0.0, 1.0, 1.5);
     lp_lens *pc = make_lens(0.0, -10.0, 6.0, 16.0, 0.0, 1.5, 1.0);
     if (!bubble || !pc)
@@ -660,11 +662,11 @@ static void test_critical(void)
             for (int k = 1; k <= 12; k++) {
                 if (side == 0 && k > 1)
                     break;
-                LD delta = side == 0 ? 0.0L : powl(10.0L, -k);
+                LD delta = side == 0 ? REF(0.0) : ref_pow(REF(10.0), -k);
                 LD th = thc + side * delta;
                 char what[96];
                 snprintf(what, sizeof what, "critical %s theta_c%+d*1e-%d", pn, side, side ? k : 0);
-                lp_vec3 d = V((double)sinl(th), 0.0, (double)cosl(th));
+                lp_vec3 d = V((double)ref_sin(th), 0.0, (double)ref_cos(th));
                 lv3 dl = lnorm(lfrom(d));
                 lv3 s_hat = L3(0, 1, 0), p_hat = lcross(dl, s_hat);
                 lv3 e_in = pol == 0 ? s_hat
@@ -673,21 +675,21 @@ static void test_critical(void)
                 lp_ray in = make_ray(vscale(d, -100.0), d, lto(e_in), 550.0, 1.0);
                 if (trace(bubble, &in, 1, &res, what) != LP_OK)
                     continue;
-                cv E = cv_axpy(cv_zero(), 1.0L, e_in), Er;
+                cv E = cv_axpy(cv_zero(), REF(1.0), e_in), Er;
                 ref_fr f = node_fields(dl, L3(0, 0, -1), E, n1, n2, &Er, NULL, NULL, NULL);
-                LD w = sqrtl(fabsl(f.w2));
+                LD w = ref_sqrt(ref_fabs(f.w2));
                 cv got = depth_field(&res, 1, 1);
                 double tol = 1e-14 + 32.0 * EPS / (double)w;
                 CHECK_ABS((double)cv_dist(got, Er), 0.0, tol, "%s: reflected field", what);
                 note(&e_field, (double)cv_dist(got, Er) / tol);
-                LD R = pol == 0 ? f.Rs : (pol == 1 ? f.Rp : 0.5L * (f.Rs + f.Rp));
-                LD T = pol == 0 ? f.Ts : (pol == 1 ? f.Tp : 0.5L * (f.Ts + f.Tp));
+                LD R = pol == 0 ? f.Rs : (pol == 1 ? f.Rp : REF(0.5) * (f.Rs + f.Rp));
+                LD T = pol == 0 ? f.Ts : (pol == 1 ? f.Tp : REF(0.5) * (f.Ts + f.Tp));
                 if (side == 0) {
                     CHECK(res.out >= 1.0 - 1e-5 && res.out <= 1.0 + 1e-14,
                           "%s: R = %.17g not ~1", what, res.out);
                     printf("critical %s at theta_c (double ray): closed form %s (cos^2 t = "
-                           "%.3Lg), library R = %.17g, T = %.3g\n",
-                           pn, f.tir ? "TIR" : "below", f.w2, res.out, res.truncated);
+                           "%.3g), library R = %.17g, T = %.3g\n",
+                           pn, f.tir ? "TIR" : "below", (double)f.w2, res.out, res.truncated);
                     continue;
                 }
                 if (f.tir) {
@@ -695,21 +697,21 @@ static void test_critical(void)
                     CHECK_REL(res.out, 1.0, 1e-14, "%s: TIR reflects everything", what);
                     if (pol < 2) {
                         lv3 u = pol == 0 ? s_hat : lcross(lnorm(L3(d.x, 0, -(LD)d.z)), s_hat);
-                        long double complex a_got = cv_dot(got, u), a_ref = cv_dot(Er, u);
-                        LD ph_got = cargl(a_got), ph_ref = cargl(a_ref);
+                        ref_complex a_got = cv_dot(got, u), a_ref = cv_dot(Er, u);
+                        LD ph_got = ref_carg(a_got), ph_ref = ref_carg(a_ref);
                         CHECK_ABS((double)ph_got, (double)ph_ref, tol, "%s: TIR phase", what);
-                        CHECK(fabsl(ph_got) < phase_prev[pol] || phase_prev[pol] < 0,
-                              "%s: |TIR phase| %.3Lg not below the previous %.3Lg", what,
-                              fabsl(ph_got), phase_prev[pol]);
-                        phase_prev[pol] = fabsl(ph_got);
+                        CHECK(ref_fabs(ph_got) < phase_prev[pol] || phase_prev[pol] < 0,
+                              "%s: |TIR phase| %.3g not below the previous %.3g", what,
+                              (double)ref_fabs(ph_got), (double)phase_prev[pol]);
+                        phase_prev[pol] = ref_fabs(ph_got);
                         if (k == 12)
-                            printf("critical %s: TIR phase at theta_c+1e-12 = %.6Lg rad "
-                                   "(closed form %.6Lg)\n",
-                                   pn, ph_got, ph_ref);
+                            printf("critical %s: TIR phase at theta_c+1e-12 = %.6g rad "
+                                   "(closed form %.6g)\n",
+                                   pn, (double)ph_got, (double)ph_ref);
                     }
                     above[k] = got;
                 } else {
-                    double tolT = 1e-13 + 32.0 * EPS / (double)fabsl(f.w2);
+                    double tolT = 1e-13 + 32.0 * EPS / (double)ref_fabs(f.w2);
                     CHECK_REL(res.truncated, (double)T, tolT, "%s: transmitted = 1 - R", what);
                     note(&e_T, relerr(res.truncated, T) / tolT);
                     CHECK_ABS(res.out, (double)R, tolT * (double)T + 1e-15, "%s: R", what);
@@ -718,27 +720,27 @@ static void test_critical(void)
             }
         }
         for (int k = 1; k <= 12; k++) {
-            LD lim = 32.0L * sqrtl(powl(10.0L, -k));
+            LD lim = REF(32.0) * ref_sqrt(ref_pow(REF(10.0), -k));
             CHECK_ABS((double)cv_dist(above[k], below[k]), 0.0, (double)lim,
                       "critical %s: field continuous across theta_c -+ 1e-%d", pn, k);
         }
     }
 
     /* (b) inside glass */
-    const LD T0 = 1.0L - 0.04L;
+    const LD T0 = REF(1.0) - REF(0.04);
     for (int pol = 0; pol < 2; pol++) {
         const char *pn = pol ? "p" : "s";
         for (int side = -1; side <= 1; side += 2) {
             for (int k = 1; k <= 12; k++) {
-                LD delta = powl(10.0L, -k), th = thc + side * delta;
-                double h = (double)(10.0L * sinl(th));
+                LD delta = ref_pow(REF(10.0), -k), th = thc + side * delta;
+                double h = (double)(REF(10.0) * ref_sin(th));
                 char what[96];
                 snprintf(what, sizeof what, "in glass %s theta_c%+de-%d", pn, side, k);
                 lp_ray in = make_ray(V(0.0, h, -5.0), V(0, 0, 1), pol ? V(0, 1, 0) : V(1, 0, 0),
                                      550.0, 1.0);
                 if (trace(pc, &in, 2, &res, what) != LP_OK)
                     continue;
-                LD si2 = ((LD)h / 10.0L) * ((LD)h / 10.0L), ci = sqrtl(1.0L - si2);
+                LD si2 = ((LD)h / REF(10.0)) * ((LD)h / REF(10.0)), ci = ref_sqrt(REF(1.0) - si2);
                 ref_fr f = fr_eval(ci, si2, n1, n2);
                 int c2;
                 double I2 = depth_power(&res, 2, &c2);
@@ -786,27 +788,27 @@ static void test_brewster(void)
     lp_result_init(&res);
     double e_field = 0, worst_at = 0;
     for (int internal = 0; internal < 2; internal++) {
-        const LD n1 = internal ? 1.5L : 1.0L, n2 = internal ? 1.0L : 1.5L;
+        const LD n1 = internal ? REF(1.5) : REF(1.0), n2 = internal ? REF(1.0) : REF(1.5);
         lp_lens *lens = make_lens(0.0, 0.0, 10.0, 100.0, 0.0, (double)n2, (double)n1);
         if (!lens)
             continue;
-        const LD thb = atanl(n2 / n1);
+        const LD thb = ref_atan(n2 / n1);
         for (int pol = 1; pol < 3; pol++) {
             const char *pn = pol == 1 ? "p" : "45deg";
             for (int side = -1; side <= 1; side++) {
                 for (int k = side ? 1 : 12; k <= 12; k++) {
-                    LD th = thb + side * powl(10.0L, -k);
+                    LD th = thb + side * ref_pow(REF(10.0), -k);
                     char what[96];
                     snprintf(what, sizeof what, "brewster %s %s theta_B%+de-%d",
                              internal ? "internal" : "external", pn, side, side ? k : 0);
-                    lp_vec3 d = V((double)sinl(th), 0.0, (double)cosl(th));
+                    lp_vec3 d = V((double)ref_sin(th), 0.0, (double)ref_cos(th));
                     lv3 dl = lnorm(lfrom(d));
                     lv3 s_hat = L3(0, 1, 0), p_hat = lcross(dl, s_hat);
                     lv3 e_in = pol == 1 ? p_hat : lnorm(ladd(s_hat, p_hat));
                     lp_ray in = make_ray(vscale(d, -100.0), d, lto(e_in), 550.0, 1.0);
                     if (trace(lens, &in, 2, &res, what) != LP_OK)
                         continue;
-                    cv E = cv_axpy(cv_zero(), 1.0L, e_in), Er;
+                    cv E = cv_axpy(cv_zero(), REF(1.0), e_in), Er;
                     ref_fr f = node_fields(dl, L3(0, 0, -1), E, n1, n2, &Er, NULL, NULL, NULL);
                     cv got = depth_field(&res, 1, 1);
                     CHECK_ABS((double)cv_dist(got, Er), 0.0, 8.0 * EPS, "%s: reflected field",
@@ -823,9 +825,9 @@ static void test_brewster(void)
                         int c2;
                         double I2 = depth_power(&res, 2, &c2);
                         CHECK_REL(I2, 1.0, 1e-14, "%s: p through both faces", what);
-                        printf("brewster %s p at theta_B: rp closed form %.3Lg, library R %.3g "
+                        printf("brewster %s p at theta_B: rp closed form %.3g, library R %.3g "
                                "(%d ray%s)\n",
-                               internal ? "internal" : "external", creall(f.rp), I1, c1,
+                               internal ? "internal" : "external", (double)ref_creal(f.rp), I1, c1,
                                c1 == 1 ? "" : "s");
                     } else {
                         CHECK(c1 == 1 && r1, "%s: one depth-1 ray", what);
@@ -867,11 +869,11 @@ static void normal_case(const lp_lens *lens, lv3 O, lv3 dl, lv3 e_in, lp_result 
     if (trace(lens, &in, 3, res, what) != LP_OK)
         return;
     dl = lnorm(lfrom(in.dir));
-    cv E = cv_axpy(cv_zero(), 1.0L, e_in), E1, Et, E2, Er2, E3;
+    cv E = cv_axpy(cv_zero(), REF(1.0), e_in), E1, Et, E2, Er2, E3;
     lv3 t, r2;
-    node_fields(dl, L3(0, 0, -1), E, 1.0L, 1.5L, &E1, &Et, NULL, &t);
-    node_fields(t, L3(0, 0, 1), Et, 1.5L, 1.0L, &Er2, &E2, &r2, NULL);
-    node_fields(r2, L3(0, 0, -1), Er2, 1.5L, 1.0L, NULL, &E3, NULL, NULL);
+    node_fields(dl, L3(0, 0, -1), E, REF(1.0), REF(1.5), &E1, &Et, NULL, &t);
+    node_fields(t, L3(0, 0, 1), Et, REF(1.5), REF(1.0), &Er2, &E2, &r2, NULL);
+    node_fields(r2, L3(0, 0, -1), Er2, REF(1.5), REF(1.0), NULL, &E3, NULL, NULL);
     cv want[3] = {E1, E2, E3};
     for (int dep = 1; dep <= 3; dep++) {
         int c;
@@ -886,7 +888,8 @@ static void normal_case(const lp_lens *lens, lv3 O, lv3 dl, lv3 e_in, lp_result 
         CHECK_ABS(depth_power(res, 1, NULL), I_normal, 1e-15, "%s: R = R(normal)", what);
         const lp_out_ray *r2o = first_at_depth(res, 2);
         if (r2o)
-            CHECK(fabsl(ldot(lfrom(r2o->ray.vp), e_in)) >= 1.0L - 1e-14L, "%s: vp kept", what);
+            CHECK(ref_fabs(ldot(lfrom(r2o->ray.vp), e_in)) >= REF(1.0) - REF(1e-14), "%s: vp kept",
+                  what);
     }
 }
 
@@ -911,7 +914,7 @@ static void test_normal(void)
         char what[96];
         snprintf(what, sizeof what, "normal exact psi=%g", psis[ip]);
         if (trace(plate, &in, 3, &res, what) == LP_OK) {
-            const LD amp[3] = {-0.2L, 0.96L, 0.96L * 0.2L};
+            const LD amp[3] = {-REF(0.2), REF(0.96), REF(0.96) * REF(0.2)};
             for (int dep = 1; dep <= 3; dep++) {
                 cv want = cv_axpy(cv_zero(), amp[dep - 1], lfrom(in.vp));
                 cv got = depth_field(&res, dep, 0);
@@ -926,27 +929,27 @@ static void test_normal(void)
         for (int iphi = 0; iphi < 3; iphi++) {
             for (size_t id = 0; id < sizeof deltas / sizeof deltas[0]; id++) {
                 LD de = deltas[id], ph = phis[iphi];
-                lv3 dl = L3(sinl(de) * cosl(ph), sinl(de) * sinl(ph), cosl(de));
+                lv3 dl = L3(ref_sin(de) * ref_cos(ph), ref_sin(de) * ref_sin(ph), ref_cos(de));
                 lv3 e = lsub(vp0, lscale(dl, ldot(vp0, dl)));
                 e = lnorm(e);
                 snprintf(what, sizeof what, "normal plate psi=%g phi=%g delta=%g", psis[ip],
                          phis[iphi], (double)de);
-                lv3 O = ladd(L3(0.3, -0.2, 0), lscale(dl, -5.0L));
-                normal_case(plate, O, dl, e, &res, de <= 1e-8L ? I_normal : -1.0, what,
+                lv3 O = ladd(L3(0.3, -0.2, 0), lscale(dl, -REF(5.0)));
+                normal_case(plate, O, dl, e, &res, de <= REF(1e-8) ? I_normal : -1.0, what,
                             &e_field);
                 /* the vertex of a biconvex lens; a ray 1e-12 mm off axis */
-                if (de == 0.0L) {
+                if (de == REF(0.0)) {
                     for (int off = 0; off < 2; off++) {
                         snprintf(what, sizeof what, "normal biconvex axis+%de-12 psi=%g phi=%g",
                                  off, psis[ip], phis[iphi]);
-                        lv3 Ob = L3(off ? 1e-12L * cosl(ph) : 0.0L, off ? 1e-12L * sinl(ph) : 0.0L,
-                                    -5);
+                        lv3 Ob = L3(off ? REF(1e-12) * ref_cos(ph) : REF(0.0),
+                                    off ? REF(1e-12) * ref_sin(ph) : REF(0.0), -5);
                         lp_ray inb = make_ray(lto(Ob), V(0, 0, 1), lto(vp0), 550.0, 1.0);
                         if (trace(bicx, &inb, 3, &res, what) != LP_OK)
                             continue;
                         ref_tree tr;
                         ref_chain(&Lb, lfrom(inb.origin), L3(0, 0, 1),
-                                  cv_axpy(cv_zero(), 1.0L, vp0), 1.5L, 1.0L, 3, &tr);
+                                  cv_axpy(cv_zero(), REF(1.0), vp0), REF(1.5), REF(1.0), 3, &tr);
                         for (int dep = 1; dep <= 3; dep++) {
                             cv got = depth_field(&res, dep, 0);
                             CHECK(tr.present[dep], "%s: reference has depth %d", what, dep);
@@ -976,7 +979,7 @@ static void test_normal(void)
  * thickness D/10; rays aimed at uniform points of the front cap from two
  * lens sizes away at angles up to 0, 30, 60, 85 degrees, and from
  * uniform points of the back cap through the glass.  For every ray whose
- * exact (long double, lens_reference.h) first hit is the front cap,
+ * exact (ref_real, lens_reference.h) first hit is the front cap,
  * lp_lens_intersect must report the front cap within
  *     |p - p_exact| <= 32 eps (distance + size)/|cos i|
  * (a sideways shift delta of the ray moves the hit by delta/|cos i|; the
@@ -1012,7 +1015,7 @@ typedef struct {
 static void isect_lens(double R, double D, isect_stats *st)
 {
     double a = 0.5 * D;
-    double sag_edge = (double)rsag(R == 0.0 ? 0.0L : 1.0L / (LD)R, a);
+    double sag_edge = (double)rsag(R == 0.0 ? REF(0.0) : REF(1.0) / (LD)R, a);
     double t = (sag_edge > 0.0 ? sag_edge : 0.0) + 0.1 * D;
     lp_lens *lens = make_lens(R, INFINITY, t, D, 0.0, 1.5, 1.0);
     if (!lens)
@@ -1022,29 +1025,29 @@ static void isect_lens(double R, double D, isect_stats *st)
     static const double max_angle_deg[] = {0.0, 30.0, 60.0, 85.0};
     for (int set = 0; set < 5; set++) {
         for (int i = 0; i < 2000; i++) {
-            LD rr = sqrtl(bench_u01()) * L.a1, ph = 2.0L * PI_L * bench_u01();
-            lv3 T = L3(rr * cosl(ph), rr * sinl(ph), rsag(L.c1, rr));
+            LD rr = ref_sqrt(bench_u01()) * L.a1, ph = REF(2.0) * REF_PI * bench_u01();
+            lv3 T = L3(rr * ref_cos(ph), rr * ref_sin(ph), rsag(L.c1, rr));
             lp_vec3 o, dir;
             if (set < 4) {
-                LD beta = (LD)max_angle_deg[set] * PI_L / 180.0L * bench_u01();
-                LD az = 2.0L * PI_L * bench_u01();
-                lv3 d = L3(sinl(beta) * cosl(az), sinl(beta) * sinl(az), cosl(beta));
-                LD dist = 2.0L * L.size;
+                LD beta = (LD)max_angle_deg[set] * REF_PI / REF(180.0) * bench_u01();
+                LD az = REF(2.0) * REF_PI * bench_u01();
+                lv3 d = L3(ref_sin(beta) * ref_cos(az), ref_sin(beta) * ref_sin(az), ref_cos(beta));
+                LD dist = REF(2.0) * L.size;
                 o = lto(lsub(T, lscale(d, dist)));
                 dir = lto(d);
             } else {
-                LD rb = sqrtl(bench_u01()) * L.a1, pb = 2.0L * PI_L * bench_u01();
-                o = V((double)(rb * cosl(pb)), (double)(rb * sinl(pb)), t);
+                LD rb = ref_sqrt(bench_u01()) * L.a1, pb = REF(2.0) * REF_PI * bench_u01();
+                o = V((double)(rb * ref_cos(pb)), (double)(rb * ref_sin(pb)), t);
                 dir = V((double)(T.x - o.x), (double)(T.y - o.y), (double)(T.z - o.z));
             }
             lv3 O = lfrom(o), d = lnorm(lfrom(dir));
-            LD smin = set < 4 ? 0.0L : 1e-9L * L.size;
+            LD smin = set < 4 ? REF(0.0) : REF(1e-9) * L.size;
             ref_hit h = ref_intersect(&L, O, d, smin);
             if (h.surf != LP_SURFACE_FRONT)
                 continue;
             st->rays++;
-            LD ci = fabsl(ldot(d, h.n));
-            double tol = (double)(32.0L * EPS * (h.s + L.size) / ci);
+            LD ci = ref_fabs(ldot(d, h.n));
+            double tol = (double)(REF(32.0) * EPS * (h.s + L.size) / ci);
             lp_hit hit;
             int got = lp_lens_intersect(lens, o, dir, 0.0, INFINITY, &hit);
             CHECK(got, "radii R=%g D=%g set %d ray %d: no hit", R, D, set, i);
@@ -1056,10 +1059,10 @@ static void isect_lens(double R, double D, isect_stats *st)
             note(&st->worst_ratio, e / tol);
             if (hit.surface != LP_SURFACE_FRONT) {
                 st->mismatches++;
-                LD r = sqrtl(h.p.x * h.p.x + h.p.y * h.p.y);
-                CHECK(fabsl(r - L.a1) <= tol,
-                      "radii R=%g D=%g set %d ray %d: surface %d, exact front at r = %.17Lg", R,
-                      D, set, i, hit.surface, r);
+                LD r = ref_sqrt(h.p.x * h.p.x + h.p.y * h.p.y);
+                CHECK(ref_fabs(r - L.a1) <= tol,
+                      "radii R=%g D=%g set %d ray %d: surface %d, exact front at r = %.17g", R,
+                      D, set, i, hit.surface, (double)r);
                 continue;
             }
             double ntol = tol / (R == 0.0 ? INFINITY : fabs(R)) + 8.0 * EPS;
@@ -1079,10 +1082,10 @@ static int through_ray(double R, int back, lp_result *res, ref_tree *tr, double 
     const double D = 1.8, a = 0.9;
     double t;
     if (!back) {
-        double sg = (double)rsag(R == 0.0 || isinf(R) ? 0.0L : 1.0L / (LD)R, a);
+        double sg = (double)rsag(R == 0.0 || isinf(R) ? REF(0.0) : REF(1.0) / (LD)R, a);
         t = (sg > 0.0 ? sg : 0.0) + 0.18;
     } else {
-        double sg = (double)rsag(R == 0.0 || isinf(R) ? 0.0L : 1.0L / (LD)R, a);
+        double sg = (double)rsag(R == 0.0 || isinf(R) ? REF(0.0) : REF(1.0) / (LD)R, a);
         t = (sg < 0.0 ? -sg : 0.0) + 0.18;
     }
     double R1 = back ? 0.0 : R, R2 = back ? R : 0.0;
@@ -1092,8 +1095,8 @@ static int through_ray(double R, int back, lp_result *res, ref_tree *tr, double 
     ref_lens L;
     ref_init(&L, R1, R2, t, D, 0.0);
     *size = L.size;
-    lv3 d = lnorm(L3(0.08L, 0.3L, 1.0L));
-    lv3 O = lsub(L3(0.0L, 0.35L, 0.0L), lscale(d, 2.0L));
+    lv3 d = lnorm(L3(REF(0.08), REF(0.3), REF(1.0)));
+    lv3 O = lsub(L3(REF(0.0), REF(0.35), REF(0.0)), lscale(d, REF(2.0)));
     lp_ray in = make_ray(lto(O), lto(d), V(1, 0, 0), 550.0, 1.0);
     char what[96];
     snprintf(what, sizeof what, "radii through R%d=%g", back ? 2 : 1, R);
@@ -1103,8 +1106,8 @@ static int through_ray(double R, int back, lp_result *res, ref_tree *tr, double 
         return 0;
     lv3 dn = lnorm(lfrom(in.dir));
     lv3 e = lsub(lfrom(in.vp), lscale(dn, ldot(lfrom(in.vp), dn)));
-    ref_chain(&L, lfrom(in.origin), lfrom(in.dir), cv_axpy(cv_zero(), 1.0L, lnorm(e)), 1.5L, 1.0L,
-              2, tr);
+    ref_chain(&L, lfrom(in.origin), lfrom(in.dir), cv_axpy(cv_zero(), REF(1.0), lnorm(e)), REF(1.5),
+              REF(1.0), 2, tr);
     return first_at_depth(res, 2) != NULL;
 }
 
@@ -1185,8 +1188,8 @@ static void test_radii(void)
                           what, dev, prev);
                 }
                 if (e10 == 9)
-                    printf("radii: R%d = %+g: deviation from flat %.6g (exact %.6Lg)\n",
-                           back ? 2 : 1, R, dev, dev_ref);
+                    printf("radii: R%d = %+g: deviation from flat %.6g (exact %.6g)\n",
+                           back ? 2 : 1, R, dev, (double)dev_ref);
                 prev = dev;
             }
         }
@@ -1293,26 +1296,27 @@ static void tangent_rays(const lp_lens *lens, const ref_lens *L, const char *nam
 {
     static const double fr[3] = {0.3, 0.7, 0.99};
     for (int cap = 0; cap < 2; cap++) {
-        LD c = cap ? L->c2 : L->c1, z0 = cap ? L->t : 0.0L, a = cap ? L->a2 : L->a1;
+        LD c = cap ? L->c2 : L->c1, z0 = cap ? L->t : REF(0.0), a = cap ? L->a2 : L->a1;
         for (int ifr = 0; ifr < 3; ifr++) {
             for (int iphi = 0; iphi < 2; iphi++) {
-                LD ph = 1.1L * iphi, r = fr[ifr] * a;
-                lv3 P = L3(r * cosl(ph), r * sinl(ph), z0 + rsag(c, r));
-                lv3 n = lnorm(L3(c * P.x, c * P.y, c * (P.z - z0) - 1.0L));
-                lv3 ephi = L3(-sinl(ph), cosl(ph), 0);
+                LD ph = REF(1.1) * iphi, r = fr[ifr] * a;
+                lv3 P = L3(r * ref_cos(ph), r * ref_sin(ph), z0 + rsag(c, r));
+                lv3 n = lnorm(L3(c * P.x, c * P.y, c * (P.z - z0) - REF(1.0)));
+                lv3 ephi = L3(-ref_sin(ph), ref_cos(ph), 0);
                 lv3 mer = lcross(n, ephi);
                 lv3 tans[3] = {ephi, mer, lnorm(ladd(ephi, mer))};
-                LD offs[5] = {0.0L, EPS * 8.0L, -EPS * 8.0L, 1e-9L * L->size, -1e-9L * L->size};
+                LD offs[5] = {REF(0.0), EPS * REF(8.0), -EPS * REF(8.0), REF(1e-9) * L->size,
+                              -REF(1e-9) * L->size};
                 for (int it = 0; it < 3; it++)
                     for (int sgn = -1; sgn <= 1; sgn += 2)
                         for (int io = 0; io < 5; io++) {
                             lv3 tdir = lscale(tans[it], sgn);
                             lv3 Q = ladd(P, lscale(n, offs[io]));
-                            lv3 O = lsub(Q, lscale(tdir, 2.0L * L->size));
+                            lv3 O = lsub(Q, lscale(tdir, REF(2.0) * L->size));
                             char what[128];
                             snprintf(what, sizeof what,
-                                     "tangent %s cap %d r %.2g a phi %.2Lg dir %d%+d off %.2Lg",
-                                     name, cap, fr[ifr], ph, it, sgn, offs[io]);
+                                     "tangent %s cap %d r %.2g a phi %.2g dir %d%+d off %.2g",
+                                     name, cap, fr[ifr], (double)ph, it, sgn, (double)offs[io]);
                             edge_probe(lens, lto(O), lto(tdir), res, what);
                         }
             }
@@ -1362,12 +1366,12 @@ static void test_edges(void)
         ref_init(&L, 5, -5, 2, 6, 0);
         const double eps_lens = 1e-12 * 6.0;
         ref_tree lim;
-        ref_chain(&L, L3(0, 3.0L * (1.0L - 1e-15L), -3), L3(0, 0, 1),
-                  cv_axpy(cv_zero(), 1.0L, L3(1, 0, 0)), ng, 1.0L, 60, &lim);
+        ref_chain(&L, L3(0, REF(3.0) * (REF(1.0) - REF(1e-15)), -3), L3(0, 0, 1),
+                  cv_axpy(cv_zero(), REF(1.0), L3(1, 0, 0)), ng, REF(1.0), 60, &lim);
         double worst_dir = 0, worst_I = 0, worst_amp = 0, thinnest = -INFINITY;
         int deepest = 0;
         for (int k = 1; k <= 14; k++) {
-            LD hl = 3.0L * (1.0L - powl(10.0L, -k));
+            LD hl = REF(3.0) * (REF(1.0) - ref_pow(REF(10.0), -k));
             double h = (double)hl;
             char what[96];
             snprintf(what, sizeof what, "knife n=%g h=3(1-1e-%d)", ng, k);
@@ -1381,12 +1385,12 @@ static void test_edges(void)
                        res.warnings & LP_WARN_LEAK ? ", LP_WARN_LEAK" : "");
             /* the reference, and its sensitivity to the start height and
              * angle (finite differences of 1e-12 mm and 1e-12 rad) */
-            const LD dh = 1e-12L, da = 1e-12L;
-            cv E0 = cv_axpy(cv_zero(), 1.0L, L3(1, 0, 0));
+            const LD dh = REF(1e-12), da = REF(1e-12);
+            cv E0 = cv_axpy(cv_zero(), REF(1.0), L3(1, 0, 0));
             ref_tree tr, tp, ta;
-            ref_chain(&L, L3(0, h, -3), L3(0, 0, 1), E0, ng, 1.0L, 60, &tr);
-            ref_chain(&L, L3(0, (LD)h - dh, -3), L3(0, 0, 1), E0, ng, 1.0L, 60, &tp);
-            ref_chain(&L, L3(0, h, -3), L3(0, sinl(da), cosl(da)), E0, ng, 1.0L, 60, &ta);
+            ref_chain(&L, L3(0, h, -3), L3(0, 0, 1), E0, ng, REF(1.0), 60, &tr);
+            ref_chain(&L, L3(0, (LD)h - dh, -3), L3(0, 0, 1), E0, ng, REF(1.0), 60, &tp);
+            ref_chain(&L, L3(0, h, -3), L3(0, ref_sin(da), ref_cos(da)), E0, ng, REF(1.0), 60, &ta);
             for (int dep = 1; dep <= 60; dep++) {
                 int c;
                 double Ip = depth_power(&res, dep, &c);
@@ -1396,19 +1400,22 @@ static void test_edges(void)
                       what, dep, c, tr.present[dep]);
                 if (!c || !tr.present[dep])
                     continue;
-                if (tr.minseg[dep] < 10.0L * eps_lens)
+                if (tr.minseg[dep] < REF(10.0) * eps_lens)
                     break; /* the library ignores surfaces closer than eps */
                 deepest = dep > deepest ? dep : deepest;
                 note(&thinnest, -(double)tr.minseg[dep]);
-                LD Iref = ldot(L3(cabsl(tr.E[dep].x), cabsl(tr.E[dep].y), cabsl(tr.E[dep].z)),
-                               L3(cabsl(tr.E[dep].x), cabsl(tr.E[dep].y), cabsl(tr.E[dep].z)));
-                LD Ipp = ldot(L3(cabsl(tp.E[dep].x), cabsl(tp.E[dep].y), cabsl(tp.E[dep].z)),
-                              L3(cabsl(tp.E[dep].x), cabsl(tp.E[dep].y), cabsl(tp.E[dep].z)));
-                LD Ipa = ldot(L3(cabsl(ta.E[dep].x), cabsl(ta.E[dep].y), cabsl(ta.E[dep].z)),
-                              L3(cabsl(ta.E[dep].x), cabsl(ta.E[dep].y), cabsl(ta.E[dep].z)));
+                LD Iref =
+                    ldot(L3(ref_cabs(tr.E[dep].x), ref_cabs(tr.E[dep].y), ref_cabs(tr.E[dep].z)),
+                         L3(ref_cabs(tr.E[dep].x), ref_cabs(tr.E[dep].y), ref_cabs(tr.E[dep].z)));
+                LD Ipp =
+                    ldot(L3(ref_cabs(tp.E[dep].x), ref_cabs(tp.E[dep].y), ref_cabs(tp.E[dep].z)),
+                         L3(ref_cabs(tp.E[dep].x), ref_cabs(tp.E[dep].y), ref_cabs(tp.E[dep].z)));
+                LD Ipa =
+                    ldot(L3(ref_cabs(ta.E[dep].x), ref_cabs(ta.E[dep].y), ref_cabs(ta.E[dep].z)),
+                         L3(ref_cabs(ta.E[dep].x), ref_cabs(ta.E[dep].y), ref_cabs(ta.E[dep].z)));
                 LD s_dir = L.size * llen(lsub(tp.dir[dep], tr.dir[dep])) / dh +
                            llen(lsub(ta.dir[dep], tr.dir[dep])) / da;
-                LD s_I = (L.size * fabsl(Ipp - Iref) / dh + fabsl(Ipa - Iref) / da) / Iref;
+                LD s_I = (L.size * ref_fabs(Ipp - Iref) / dh + ref_fabs(Ipa - Iref) / da) / Iref;
                 double tol_dir = dep * (1e-14 + 16.0 * EPS * (double)s_dir);
                 double tol_I = dep * (1e-12 + 16.0 * EPS * (double)s_I);
                 CHECK_REL(Ip, (double)Iref, tol_I, "%s: intensity at depth %d", what, dep);
@@ -1455,12 +1462,12 @@ static void test_thin_plate(void)
     double e_I = 0, e_op = 0, e_x = 0;
     for (int ia = 0; ia < 4; ia++) {
         for (int pol = 0; pol < 2; pol++) {
-            LD th = degs[ia] * PI_L / 180.0L;
-            lp_vec3 d = V((double)sinl(th), 0.0, (double)cosl(th));
+            LD th = degs[ia] * REF_PI / REF(180.0);
+            lp_vec3 d = V((double)ref_sin(th), 0.0, (double)ref_cos(th));
             LD ci, si2;
             dir_angles(d, &ci, &si2);
-            ref_fr f = fr_eval(ci, si2, 1.0L, n);
-            LD R = pol ? f.Rp : f.Rs, T = 1.0L - R, cr = f.ct, tr = sqrtl(si2) / n / cr;
+            ref_fr f = fr_eval(ci, si2, REF(1.0), n);
+            LD R = pol ? f.Rp : f.Rs, T = REF(1.0) - R, cr = f.ct, tr = ref_sqrt(si2) / n / cr;
             char what[96];
             snprintf(what, sizeof what, "1um plate %s %g deg", pol ? "p" : "s", degs[ia]);
             lp_ray in = make_ray(vscale(d, -1.0), d, pol ? V(-d.z, 0, d.x) : V(0, 1, 0), 550.0,
@@ -1485,11 +1492,11 @@ static void test_thin_plate(void)
                     x = 0;
                 } else if (through) {
                     int k = (dep - 2) / 2;
-                    want = T * T * powl(R, 2 * k);
+                    want = T * T * ref_pow(R, 2 * k);
                     x = (2 * k + 1) * t * tr;
                 } else {
                     int k = (dep - 1) / 2;
-                    want = T * T * powl(R, 2 * k - 1);
+                    want = T * T * ref_pow(R, 2 * k - 1);
                     x = 2 * k * t * tr;
                 }
                 double tol = dep * 1e-13 > 1e-12 ? dep * 1e-13 : 1e-12;
@@ -1499,7 +1506,7 @@ static void test_thin_plate(void)
                           dep);
                 note(&e_x, fabs(o->ray.origin.x - (double)(x0 + x)));
                 if (dep >= 2 && prev[through]) {
-                    LD step = 2.0L * n * t / cr;
+                    LD step = REF(2.0) * n * t / cr;
                     CHECK_REL(o->ray.op - prev[through]->ray.op, (double)step, 1e-9,
                               "%s: op step at depth %d", what, dep);
                     note(&e_op, relerr(o->ray.op - prev[through]->ray.op, step));
@@ -1507,7 +1514,7 @@ static void test_thin_plate(void)
                 if (dep >= 2)
                     prev[through] = o;
             }
-            CHECK_REL(res.truncated, (double)(T * powl(R, 39)), 4e-12, "%s: truncated", what);
+            CHECK_REL(res.truncated, (double)(T * ref_pow(R, 39)), 4e-12, "%s: truncated", what);
         }
     }
     printf("1um plate: max rel error intensity %.3g, op step %.3g; max |dx| %.3g mm\n", e_I, e_op,
@@ -1537,9 +1544,9 @@ static void test_thin_plate(void)
  * medium.  lp_backward_build refuses the same wavelengths. */
 static LD bk7_n2(LD lambda_nm)
 {
-    static const LD B[3] = {1.03961212L, 0.231792344L, 1.01046945L};
-    static const LD C[3] = {0.00600069867L, 0.0200179144L, 103.560653L};
-    LD l2 = (lambda_nm * 1e-3L) * (lambda_nm * 1e-3L), n2 = 1.0L;
+    static const LD B[3] = {REF(1.03961212), REF(0.231792344), REF(1.01046945)};
+    static const LD C[3] = {REF(0.00600069867), REF(0.0200179144), REF(103.560653)};
+    LD l2 = (lambda_nm * REF(1e-3)) * (lambda_nm * REF(1e-3)), n2 = REF(1.0);
     for (int k = 0; k < 3; k++)
         n2 += B[k] * l2 / (l2 - C[k]);
     return n2;
@@ -1582,28 +1589,28 @@ static void test_wavelengths(void)
         memset(&err, 0, sizeof err);
         lp_status st = lp_trace_forward(lens, &in, &args, &res, &err);
         LD n2 = bk7_n2(lam);
-        int has_index = isfinite(n2) && n2 > 0.0L;
+        int has_index = isfinite(n2) && n2 > REF(0.0);
         if (!has_index) {
-            CHECK(st == LP_ERROR_INVALID_GLASS, "%s: n^2 = %.3Lg, status %d (%s)", what, n2,
-                  (int)st, err.message);
+            CHECK(st == LP_ERROR_INVALID_GLASS, "%s: n^2 = %.3g, status %d (%s)", what,
+                  (double)n2, (int)st, err.message);
             CHECK(res.count == 0 && res.in == 0.0, "%s: refused but %zu rays", what, res.count);
-            printf("wavelengths: %-24s n^2 = %-10.3Lg refused: %s\n", what, n2, err.message);
+            printf("wavelengths: %-24s n^2 = %-10.3g refused: %s\n", what, (double)n2, err.message);
             continue;
         }
         if (st != LP_OK) {
-            CHECK(0, "%s: n = %.17Lg but refused: %s", what, sqrtl(n2), err.message);
+            CHECK(0, "%s: n = %.17g but refused: %s", what, (double)ref_sqrt(n2), err.message);
             continue;
         }
         sane(&res, 2, what);
         int outside = lam < 300.0 || lam > 2500.0;
         CHECK(((res.warnings & LP_WARN_EXTRAPOLATED) != 0) == outside, "%s: warnings %#x", what,
               res.warnings);
-        LD n = sqrtl(n2), R = ((n - 1) / (n + 1)) * ((n - 1) / (n + 1));
+        LD n = ref_sqrt(n2), R = ((n - 1) / (n + 1)) * ((n - 1) / (n + 1));
         double R1 = depth_power(&res, 1, NULL);
-        if (R > 0.0L) {
+        if (R > REF(0.0)) {
             /* n - 1 = (1 - n) in rs cancels: n carries a few eps of n */
-            double tolR = 1e-12 + 64.0 * EPS * (double)(n / fabsl(n - 1.0L));
-            CHECK_REL(R1, (double)R, tolR, "%s: R at normal incidence (n = %.9Lg)", what, n);
+            double tolR = 1e-12 + 64.0 * EPS * (double)(n / ref_fabs(n - REF(1.0)));
+            CHECK_REL(R1, (double)R, tolR, "%s: R at normal incidence (n = %.9g)", what, (double)n);
             note(&e_R, relerr(R1, R));
         } else {
             CHECK(R1 <= 1e-30, "%s: R %g for n = 1", what, R1);
@@ -1615,7 +1622,7 @@ static void test_wavelengths(void)
             A_at[i] = res.absorbed_glass / (1.0 - R1);
         }
         if (i >= 6)
-            printf("wavelengths: %-24s n = %-10.6Lg R = %.6g%s\n", what, n, R1,
+            printf("wavelengths: %-24s n = %-10.6g R = %.6g%s\n", what, (double)n, R1,
                    res.warnings & LP_WARN_EXTRAPOLATED ? "  (extrapolated)" : "");
     }
     for (int e = 0; e < 2; e++) {
@@ -1710,13 +1717,13 @@ static void test_depth(void)
         return;
     lp_result res;
     lp_result_init(&res);
-    LD th = 30.0L * PI_L / 180.0L, chi = 53.0L * PI_L / 180.0L;
-    lp_vec3 d = V((double)sinl(th), 0, (double)cosl(th));
+    LD th = REF(30.0) * REF_PI / REF(180.0), chi = REF(53.0) * REF_PI / REF(180.0);
+    lp_vec3 d = V((double)ref_sin(th), 0, (double)ref_cos(th));
     LD ci, si2;
     dir_angles(d, &ci, &si2);
-    ref_fr f = fr_eval(ci, si2, 1.0L, n);
+    ref_fr f = fr_eval(ci, si2, REF(1.0), n);
     lv3 s_hat = L3(0, 1, 0), p_hat = lcross(lnorm(lfrom(d)), s_hat);
-    lv3 e_in = ladd(lscale(s_hat, cosl(chi)), lscale(p_hat, sinl(chi)));
+    lv3 e_in = ladd(lscale(s_hat, ref_cos(chi)), lscale(p_hat, ref_sin(chi)));
     const double I0s[] = {1.0, 1e-100, 1e-300, DBL_MIN, 1e-310, 1e-320, DBL_TRUE_MIN, 1e300,
                           DBL_MAX / 4};
     double e_rel = 0;
@@ -1733,14 +1740,15 @@ static void test_depth(void)
                 ws = f.Rs;
                 wp = f.Rp;
             } else {
-                ws = f.Ts * f.Ts * powl(f.Rs, dep - 2);
-                wp = f.Tp * f.Tp * powl(f.Rp, dep - 2);
+                ws = f.Ts * f.Ts * ref_pow(f.Rs, dep - 2);
+                wp = f.Tp * f.Tp * ref_pow(f.Rp, dep - 2);
             }
-            LD want = (LD)I0s[i] * (ws * cosl(chi) * cosl(chi) + wp * sinl(chi) * sinl(chi));
+            LD want =
+                (LD)I0s[i] * (ws * ref_cos(chi) * ref_cos(chi) + wp * ref_sin(chi) * ref_sin(chi));
             int c;
             double got = depth_power(&res, dep, &c);
             double tol = dep * 1e-13 > 1e-12 ? dep * 1e-13 : 1e-12;
-            CHECK(c == 1 || (c == 0 && want < 4.0L * DBL_TRUE_MIN), "%s: %d rays at depth %d",
+            CHECK(c == 1 || (c == 0 && want < REF(4.0) * DBL_TRUE_MIN), "%s: %d rays at depth %d",
                   what, c, dep);
             if (want >= DBL_MIN)
                 CHECK_REL(got, (double)want, tol, "%s: power at depth %d", what, dep);
@@ -1809,7 +1817,7 @@ static void test_depth(void)
         for (int ri = 0; ri < 40; ri++) {
             lv3 T = random_surface_point(&L, (int)(sm64() % 3));
             lp_vec3 dir = rand_unit();
-            lv3 O = lsub(T, lscale(lfrom(dir), 2.0L * L.size));
+            lv3 O = lsub(T, lscale(lfrom(dir), REF(2.0) * L.size));
             const double I0 = ri % 3 == 0 ? 1.0 : (ri % 3 == 1 ? 1e-300 : 1e-320);
             lp_vec3 vp = vcross(dir, rand_unit());
             lp_ray r = make_ray(lto(fw_point(&fr, O)), lto(fw_dir(&fr, lfrom(dir))),

@@ -54,6 +54,7 @@
 #include "check.h"
 #include "fresnel.h"
 #include "lensprim.h"
+#include "ref_real.h"
 
 #define PI 3.14159265358979323846
 #define DEG (PI / 180.0)
@@ -613,39 +614,39 @@ static void test_ball_lens(void)
         lp_vec3 v = vec(0.6, 0.8, 0.0);
         in.vp = unit(add(v, scale(in.dir, -dot(v, in.dir))));
         /* my entry point on the front sphere (centre (0,0,5), R = 5) and
-         * its reflectance, in long double: these rays meet the sphere
+         * its reflectance, in ref_real: these rays meet the sphere
          * nearly tangentially (cos i ~ 0.016 for beta = 35), where the
          * intersection loses ~4 digits to b^2 - c, which would make a
          * double reference the less accurate side */
-        long double u[3] = {in.dir.x, in.dir.y, in.dir.z};
-        long double ul = sqrtl(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+        ref_real u[3] = {in.dir.x, in.dir.y, in.dir.z};
+        ref_real ul = ref_sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
         for (int q = 0; q < 3; q++)
             u[q] /= ul;
-        long double dc[3] = {in.origin.x, in.origin.y, in.origin.z - 5.0L};
-        long double b = dc[0] * u[0] + dc[1] * u[1] + dc[2] * u[2];
-        long double cc = dc[0] * dc[0] + dc[1] * dc[1] + dc[2] * dc[2] - 25.0L;
-        long double t = -b - sqrtl(b * b - cc);
-        long double x[3], nm[3];
+        ref_real dc[3] = {in.origin.x, in.origin.y, in.origin.z - REF(5.0)};
+        ref_real b = dc[0] * u[0] + dc[1] * u[1] + dc[2] * u[2];
+        ref_real cc = dc[0] * dc[0] + dc[1] * dc[1] + dc[2] * dc[2] - REF(25.0);
+        ref_real t = -b - ref_sqrt(b * b - cc);
+        ref_real x[3], nm[3];
         for (int q = 0; q < 3; q++)
             x[q] = dc[q] + t * u[q]; /* relative to the centre */
         for (int q = 0; q < 3; q++)
-            nm[q] = x[q] / 5.0L;
-        long double ci = fabsl(u[0] * nm[0] + u[1] * nm[1] + u[2] * nm[2]);
-        long double st2 = (1.0L - ci) * (1.0L + ci) / ((long double)NG * NG);
-        long double ct = sqrtl(1.0L - st2);
-        long double rs = (ci - NG * ct) / (ci + NG * ct), rp = (NG * ci - ct) / (NG * ci + ct);
-        long double sv[3] = {u[1] * nm[2] - u[2] * nm[1], u[2] * nm[0] - u[0] * nm[2],
-                             u[0] * nm[1] - u[1] * nm[0]};
-        long double sl = sqrtl(sv[0] * sv[0] + sv[1] * sv[1] + sv[2] * sv[2]);
+            nm[q] = x[q] / REF(5.0);
+        ref_real ci = ref_fabs(u[0] * nm[0] + u[1] * nm[1] + u[2] * nm[2]);
+        ref_real st2 = (REF(1.0) - ci) * (REF(1.0) + ci) / ((ref_real)NG * NG);
+        ref_real ct = ref_sqrt(REF(1.0) - st2);
+        ref_real rs = (ci - NG * ct) / (ci + NG * ct), rp = (NG * ci - ct) / (NG * ci + ct);
+        ref_real sv[3] = {u[1] * nm[2] - u[2] * nm[1], u[2] * nm[0] - u[0] * nm[2],
+                          u[0] * nm[1] - u[1] * nm[0]};
+        ref_real sl = ref_sqrt(sv[0] * sv[0] + sv[1] * sv[1] + sv[2] * sv[2]);
         for (int q = 0; q < 3; q++)
             sv[q] /= sl;
-        long double pv[3] = {u[1] * sv[2] - u[2] * sv[1], u[2] * sv[0] - u[0] * sv[2],
-                             u[0] * sv[1] - u[1] * sv[0]};
-        long double as = in.vp.x * sv[0] + in.vp.y * sv[1] + in.vp.z * sv[2];
-        long double ap = in.vp.x * pv[0] + in.vp.y * pv[1] + in.vp.z * pv[2];
-        long double r1l = rs * rs * as * as + rp * rp * ap * ap;
-        double r1 = (double)r1l, a1 = (double)(1.0L - r1l);
-        CHECK(hypotl(x[0], x[1]) < 4.95L, "%s: my entry point on the front cap", what);
+        ref_real pv[3] = {u[1] * sv[2] - u[2] * sv[1], u[2] * sv[0] - u[0] * sv[2],
+                          u[0] * sv[1] - u[1] * sv[0]};
+        ref_real as = in.vp.x * sv[0] + in.vp.y * sv[1] + in.vp.z * sv[2];
+        ref_real ap = in.vp.x * pv[0] + in.vp.y * pv[1] + in.vp.z * pv[2];
+        ref_real r1l = rs * rs * as * as + rp * rp * ap * ap;
+        double r1 = (double)r1l, a1 = (double)(REF(1.0) - r1l);
+        CHECK(ref_hypot(x[0], x[1]) < REF(4.95), "%s: my entry point on the front cap", what);
 
         lp_status st = lp_trace_forward(lens, &in, &args, &res, NULL);
         CHECK(st == LP_OK, "%s: trace", what);
