@@ -75,7 +75,7 @@ for t in build-vg/bin/test_*; do
     fi
     echo "$n"
 done | xargs -n 1 -P "$jobs" sh scripts/valgrind.sh --one | tee "$logs/summary.txt"
-pass=$(grep -c ': ok (' "$logs/summary.txt" || true)
+pass=$(grep -c ' ok (' "$logs/summary.txt" || true)
 fail=$(grep -c ' FAILED' "$logs/summary.txt" || true)
 skipped=$(grep -c ' skipped ' "$logs/summary.txt" || true)
 echo "valgrind: memcheck --leak-check=full, children traced, $jobs at a time, $(($(date +%s) - t_start)) s"
