@@ -22,19 +22,17 @@
  * executable, not to the library). */
 #define _POSIX_C_SOURCE 200809L
 
-#include <errno.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/types.h>
-#include <sys/wait.h>
 #include <dirent.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "check.h"
+#include "subprocess.h"
 
 #include "../lensprim/tools/lenstrace_args.c"
 
@@ -111,49 +109,22 @@ typedef struct run_result {
 static run_result run_lenstrace(char **args, int n)
 {
     run_result r;
-    char **argv = calloc((size_t)n + 2, sizeof *argv);
-    int fds[2], st;
-    pid_t pid;
-    double t0 = now_s();
+    const char **argv = calloc((size_t)n + 1, sizeof *argv);
+    tp_result t;
 
     memset(&r, 0, sizeof r);
     r.status = -1;
-    if (!argv || pipe(fds) != 0) {
-        free(argv);
+    if (!argv)
         return r;
-    }
-    argv[0] = (char *)LENSTRACE;
     for (int i = 0; i < n; i++)
-        argv[i + 1] = args[i];
-    fflush(stdout);
-    fflush(stderr);
-    pid = fork();
-    if (pid == 0) {
-        FILE *devnull = fopen("/dev/null", "w");
-        close(fds[0]);
-        if (!devnull || dup2(fileno(devnull), 1) < 0 || dup2(fds[1], 2) < 0)
-            _exit(126);
-        execv(LENSTRACE, argv);
-        _exit(127);
+        argv[i] = args[i];
+    if (tp_run(LENSTRACE, argv, NULL, &t) == 0) {
+        r.status = t.status;
+        snprintf(r.err, sizeof r.err, "%s", t.err);
+        r.seconds = t.seconds;
+        tp_result_free(&t);
     }
-    close(fds[1]);
-    if (pid > 0) {
-        size_t k = 0;
-        char c;
-        while (read(fds[0], &c, 1) == 1)
-            if (k + 1 < sizeof r.err)
-                r.err[k++] = c;
-        r.err[k] = '\0';
-        while (waitpid(pid, &st, 0) < 0 && errno == EINTR)
-            ;
-        if (WIFEXITED(st))
-            r.status = WEXITSTATUS(st);
-        else if (WIFSIGNALED(st))
-            r.status = 128 + WTERMSIG(st);
-    }
-    close(fds[0]);
     free(argv);
-    r.seconds = now_s() - t0;
     return r;
 }
 

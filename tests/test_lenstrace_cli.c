@@ -6,16 +6,14 @@
  * behaviour (exit 2, one stderr line, empty stdout). */
 #define _POSIX_C_SOURCE 200809L
 
-#include <errno.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/types.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "check.h"
+#include "subprocess.h"
 
 #ifndef LP_BIN_DIR
 #error "LP_BIN_DIR must name the directory of the built programs"
@@ -52,80 +50,21 @@ typedef struct proc {
     char what[512];
 } proc;
 
-static char *slurp(FILE *f)
-{
-    long n;
-    char *s;
-    fflush(f);
-    if (fseek(f, 0, SEEK_END) != 0 || (n = ftell(f)) < 0 ||
-        fseek(f, 0, SEEK_SET) != 0)
-        return NULL;
-    s = malloc((size_t)n + 1);
-    if (!s)
-        return NULL;
-    if (fread(s, 1, (size_t)n, f) != (size_t)n) {
-        free(s);
-        return NULL;
-    }
-    s[n] = '\0';
-    return s;
-}
-
 /* Run lenstrace with the given arguments (NULL-terminated array). */
 static proc run_argv(const char *const *args)
 {
     proc p;
-    const char *argv[64];
-    size_t n = 0;
-    FILE *fo = tmpfile(), *fe = tmpfile();
-    pid_t pid;
-    int st;
+    tp_result r;
 
     memset(&p, 0, sizeof p);
-    p.status = -1;
-    argv[n++] = LENSTRACE;
-    snprintf(p.what, sizeof p.what, "lenstrace");
-    for (size_t i = 0; args[i] && n < 63; i++) {
-        size_t l = strlen(p.what);
-        argv[n++] = args[i];
-        snprintf(p.what + l, sizeof p.what - l, " '%s'", args[i]);
-    }
-    argv[n] = NULL;
-    if (!fo || !fe) {
-        fprintf(stderr, "tmpfile: %s\n", strerror(errno));
+    tp_describe(LENSTRACE, args, p.what, sizeof p.what);
+    if (tp_run(LENSTRACE, args, NULL, &r) != 0) {
+        fprintf(stderr, "%s: %s\n", p.what, r.error);
         exit(1);
     }
-    fflush(stdout);
-    fflush(stderr);
-    pid = fork();
-    if (pid < 0) {
-        fprintf(stderr, "fork: %s\n", strerror(errno));
-        exit(1);
-    }
-    if (pid == 0) {
-        if (dup2(fileno(fo), 1) < 0 || dup2(fileno(fe), 2) < 0)
-            _exit(126);
-        execv(LENSTRACE, (char *const *)argv);
-        _exit(127);
-    }
-    while (waitpid(pid, &st, 0) < 0) {
-        if (errno != EINTR) {
-            fprintf(stderr, "waitpid: %s\n", strerror(errno));
-            exit(1);
-        }
-    }
-    if (WIFEXITED(st))
-        p.status = WEXITSTATUS(st);
-    else if (WIFSIGNALED(st))
-        p.status = 128 + WTERMSIG(st);
-    p.out = slurp(fo);
-    p.err = slurp(fe);
-    fclose(fo);
-    fclose(fe);
-    if (!p.out || !p.err) {
-        fprintf(stderr, "cannot read the output of %s\n", p.what);
-        exit(1);
-    }
+    p.status = r.status;
+    p.out = r.out;
+    p.err = r.err;
     if (p.status == 127)
         fprintf(stderr, "note: could not execute %s\n", LENSTRACE);
     return p;

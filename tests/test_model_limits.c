@@ -47,19 +47,14 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <complex.h>
-#include <errno.h>
-#include <fcntl.h>
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <sys/types.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "check.h"
+#include "subprocess.h"
 #include "lensprim.h"
 
 #ifndef LP_BIN_DIR
@@ -704,11 +699,6 @@ static void check_skew(void)
 /* 6: the command                                                      */
 /* ------------------------------------------------------------------ */
 
-typedef struct run_result {
-    int status;   /* exit status, 128 + signal, -1 */
-    char *out, *err;
-} run_result;
-
 static char *read_file(const char *path, long *size)
 {
     FILE *f = fopen(path, "rb");
@@ -731,49 +721,13 @@ static char *read_file(const char *path, long *size)
     return s;
 }
 
-/* Run the tool with argv[1..] = args (NULL-terminated). */
-static run_result run_tool(const char *const *args)
+/* Run the tool with argv[1..] = args (NULL-terminated).  When it cannot
+ * be run: status -1, out and err NULL. */
+static tp_result run_tool(const char *const *args)
 {
-    run_result r = {-1, NULL, NULL};
-    char out_path[512], err_path[512];
-    const char *argv[16];
-    int n = 0, st;
-    snprintf(out_path, sizeof out_path, "%s/model_limits_test.out", LP_TEST_TMP);
-    snprintf(err_path, sizeof err_path, "%s/model_limits_test.err", LP_TEST_TMP);
-    argv[n++] = TOOL;
-    while (*args && n < 15)
-        argv[n++] = *args++;
-    argv[n] = NULL;
-    fflush(stdout);
-    fflush(stderr);
-    pid_t pid = fork();
-    if (pid < 0)
-        return r;
-    if (pid == 0) {
-        int fo = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int fe = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fo < 0 || fe < 0 || dup2(fo, 1) < 0 || dup2(fe, 2) < 0)
-            _exit(126);
-        execv(TOOL, (char *const *)argv);
-        _exit(127);
-    }
-    while (waitpid(pid, &st, 0) < 0)
-        if (errno != EINTR)
-            return r;
-    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : WIFSIGNALED(st) ? 128 + WTERMSIG(st) : -1;
-    r.out = read_file(out_path, NULL);
-    r.err = read_file(err_path, NULL);
-    if (!r.out)
-        r.out = calloc(1, 1);
-    if (!r.err)
-        r.err = calloc(1, 1);
+    tp_result r;
+    tp_run(TOOL, args, NULL, &r);
     return r;
-}
-
-static void free_run(run_result *r)
-{
-    free(r->out);
-    free(r->err);
 }
 
 /* A CSV table: the header's column names and the rows' fields. */
@@ -905,7 +859,7 @@ static double closed_threshold(double n1, double n2, int depth, int model /* 1 f
 static void check_command_usage(void)
 {
     const char *help[] = {"--help", NULL};
-    run_result r = run_tool(help);
+    tp_result r = run_tool(help);
     CHECK(r.status == 0, "--help exits 0 (got %d)", r.status);
     if (r.out) {
         CHECK(strstr(r.out, "usage: model_limits") != NULL, "--help: usage line");
@@ -914,7 +868,7 @@ static void check_command_usage(void)
         CHECK(strstr(r.out, "642.4") != NULL, "--help: defines the rgb model");
         CHECK(strstr(r.out, "ybar") != NULL, "--help: defines the spectral weighting");
     }
-    free_run(&r);
+    tp_result_free(&r);
     const char *bad[] = {"--no-such-option", NULL};
     r = run_tool(bad);
     CHECK(r.status == 2, "bad option exits 2 (got %d)", r.status);
@@ -924,11 +878,11 @@ static void check_command_usage(void)
         CHECK(nl && nl[1] == '\0' && strncmp(r.err, "model_limits: ", 14) == 0,
               "bad option: one line on stderr: %s", r.err);
     }
-    free_run(&r);
+    tp_result_free(&r);
     const char *bad2[] = {"--rays", "0", NULL};
     r = run_tool(bad2);
     CHECK(r.status == 2, "--rays 0 exits 2 (got %d)", r.status);
-    free_run(&r);
+    tp_result_free(&r);
 }
 
 static void check_command_mono(void)
@@ -936,10 +890,10 @@ static void check_command_mono(void)
     char dir[512], path[600];
     snprintf(dir, sizeof dir, "%s/model_limits_mono", LP_TEST_TMP);
     const char *args[] = {"--out", dir, "--lambda", "587.5618", "--rays", "40", NULL};
-    run_result r = run_tool(args);
+    tp_result r = run_tool(args);
     CHECK(r.status == 0, "monochromatic run exits 0 (got %d): %s", r.status, r.err ? r.err : "");
     CHECK(r.out && strstr(r.out, "up to") != NULL, "monochromatic run prints the summary");
-    free_run(&r);
+    tp_result_free(&r);
     if (r.status != 0)
         return;
     static const char *const pngs[] = {"angle_air_glass.png", "angle_glass_air.png", "depth.png",
@@ -1107,9 +1061,9 @@ static void check_command_spectral(void)
     char dir[512], path[600];
     snprintf(dir, sizeof dir, "%s/model_limits_spectral", LP_TEST_TMP);
     const char *args[] = {"--out", dir, "--rays", "20", NULL};
-    run_result r = run_tool(args);
+    tp_result r = run_tool(args);
     CHECK(r.status == 0, "spectral run exits 0 (got %d): %s", r.status, r.err ? r.err : "");
-    free_run(&r);
+    tp_result_free(&r);
     if (r.status != 0)
         return;
     table t;

@@ -20,17 +20,14 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <dirent.h>
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include "check.h"
+#include "subprocess.h"
 #include "compare.h"
 #include "povray.h"
 
@@ -330,31 +327,6 @@ static char *read_text(const char *path)
 
 /* ---- running pov_compare -------------------------------------------- */
 
-/* Run argv with stdout and stderr into files; the exit status, or -1. */
-static int run(char *const argv[], const char *out_path, const char *err_path)
-{
-    pid_t pid;
-    int status;
-    fflush(NULL);
-    pid = fork();
-    if (pid < 0)
-        return -1;
-    if (pid == 0) {
-        int fo = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        int fe = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-        if (fo < 0 || fe < 0)
-            _exit(126);
-        dup2(fo, 1);
-        dup2(fe, 2);
-        execv(argv[0], argv);
-        _exit(127);
-    }
-    while (waitpid(pid, &status, 0) < 0)
-        if (errno != EINTR)
-            return -1;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-}
-
 static int count_lines(const char *s)
 {
     int n = 0;
@@ -365,31 +337,27 @@ static int count_lines(const char *s)
 
 static void test_cli_errors(void)
 {
-    char out[512], err[512];
-    snprintf(out, sizeof out, "%s/pc_stdout.txt", LP_TEST_TMP);
-    snprintf(err, sizeof err, "%s/pc_stderr.txt", LP_TEST_TMP);
+    tp_result r;
 
-    char *a1[] = {(char *)POV_COMPARE, LP_TEST_TMP "/no_such.scene", NULL};
-    int rc = run(a1, out, err);
-    char *e = read_text(err);
-    CHECK(rc == 2, "missing scene: exit %d, want 2", rc);
-    CHECK(e && count_lines(e) == 1 && strncmp(e, "pov_compare: ", 13) == 0,
-          "missing scene: want one 'pov_compare: ' line on stderr, got '%s'", e ? e : "");
-    free(e);
+    const char *a1[] = {LP_TEST_TMP "/no_such.scene", NULL};
+    tp_run(POV_COMPARE, a1, NULL, &r);
+    CHECK(r.status == 2, "missing scene: exit %d, want 2", r.status);
+    CHECK(r.err && count_lines(r.err) == 1 && strncmp(r.err, "pov_compare: ", 13) == 0,
+          "missing scene: want one 'pov_compare: ' line on stderr, got '%s'", r.err ? r.err : "");
+    tp_result_free(&r);
 
-    char *a2[] = {(char *)POV_COMPARE, (char *)(LP_SOURCE_DIR "/scenes/default.scene"),
-                  "--width", "0", NULL};
-    rc = run(a2, out, err);
-    CHECK(rc == 2, "--width 0: exit %d, want 2", rc);
+    const char *a2[] = {LP_SOURCE_DIR "/scenes/default.scene", "--width", "0", NULL};
+    tp_run(POV_COMPARE, a2, NULL, &r);
+    CHECK(r.status == 2, "--width 0: exit %d, want 2", r.status);
+    tp_result_free(&r);
 
-    char *a3[] = {(char *)POV_COMPARE, (char *)(LP_SOURCE_DIR "/scenes/default.scene"),
-                  "--povray", "/nonexistent/povray", "--out", LP_TEST_TMP "/pc_nopov", NULL};
-    rc = run(a3, out, err);
-    e = read_text(err);
-    CHECK(rc == 1, "--povray /nonexistent: exit %d, want 1", rc);
-    CHECK(e && strstr(e, "POV-Ray not found") && count_lines(e) == 1,
-          "--povray /nonexistent: want one clear line, got '%s'", e ? e : "");
-    free(e);
+    const char *a3[] = {LP_SOURCE_DIR "/scenes/default.scene", "--povray", "/nonexistent/povray",
+                        "--out", LP_TEST_TMP "/pc_nopov", NULL};
+    tp_run(POV_COMPARE, a3, NULL, &r);
+    CHECK(r.status == 1, "--povray /nonexistent: exit %d, want 1", r.status);
+    CHECK(r.err && strstr(r.err, "POV-Ray not found") && count_lines(r.err) == 1,
+          "--povray /nonexistent: want one clear line, got '%s'", r.err ? r.err : "");
+    tp_result_free(&r);
 }
 
 /* ---- the harness's measures ---------------------------------------- */
@@ -563,19 +531,17 @@ int main(void)
     }
     test_cli_errors();
 
-    char out[512], err[512], ws[16], hs[16];
-    snprintf(out, sizeof out, "%s/pc_all_stdout.txt", LP_TEST_TMP);
-    snprintf(err, sizeof err, "%s/pc_all_stderr.txt", LP_TEST_TMP);
+    char ws[16], hs[16];
     read_size();
     snprintf(ws, sizeof ws, "%d", size_w);
     snprintf(hs, sizeof hs, "%d", size_h);
     printf("pov_compare --all at %d x %d\n", size_w, size_h);
-    char *argv[] = {(char *)POV_COMPARE, "--all", (char *)SCENES, "--out", (char *)OUT,
-                    "--width", ws, "--height", hs, NULL};
-    int rc = run(argv, out, err);
-    char *e = read_text(err);
-    CHECK(rc == 0, "pov_compare --all %s: exit %d: %s", SCENES, rc, e ? e : "");
-    free(e);
+    const char *args[] = {"--all", SCENES, "--out", OUT, "--width", ws, "--height", hs, NULL};
+    tp_result r;
+    tp_run(POV_COMPARE, args, NULL, &r);
+    CHECK(r.status == 0, "pov_compare --all %s: exit %d: %s", SCENES, r.status,
+          r.err ? r.err : "");
+    tp_result_free(&r);
 
     /* Every scene of the project, each checked from its report. */
     DIR *d = opendir(SCENES);

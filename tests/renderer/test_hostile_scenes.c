@@ -28,24 +28,17 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <dirent.h>
-#include <errno.h>
-#include <fcntl.h>
 #include <math.h>
-#include <poll.h>
-#include <signal.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
-#include <sys/time.h>
-#include <sys/types.h>
-#include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "check.h"
+#include "subprocess.h"
 
 #include "args.h"
 #include "parser.h"
@@ -73,7 +66,6 @@
 #endif
 
 static const char *const LENSRENDER = LP_BIN_DIR "/lensrender";
-static const char *const MEASURE_CHILD = LP_BIN_DIR "/measure_child";
 static const char *const PARSE_MANY = LP_BIN_DIR "/parse_many";
 static const char *const REGRESSIONS = LP_SOURCE_DIR "/tests/regressions/scene";
 static const char *const SCENES = LP_SOURCE_DIR "/scenes";
@@ -532,129 +524,31 @@ typedef struct run_result {
     char err[2048];   /* stderr (start) */
 } run_result;
 
-/* Append what fd has now to buf (NUL-terminated, the start kept); returns 0
- * at end of file. */
-static int drain(int fd, char *buf, size_t size)
-{
-    char chunk[4096];
-    ssize_t n = read(fd, chunk, sizeof chunk);
-    if (n < 0)
-        return errno == EINTR;
-    size_t len = strlen(buf);
-    for (ssize_t i = 0; i < n && len + 1 < size; i++)
-        buf[len++] = chunk[i];
-    buf[len] = '\0';
-    return n > 0;
-}
-
-/* Run argv (argv[0] the program's path) through measure_child, which
- * reports the program's own peak RSS (see tests/tools/measure_child.c: a
- * child forked from this process would count this process's memory, and
- * under valgrind or ASan that is the tool's).  fsize_limit > 0 sets
- * RLIMIT_FSIZE, with SIGXFSZ ignored, so writes fail with EFBIG.  stdout
- * and stderr are captured. */
-static run_result run_measured(const char *const *argv, long fsize_limit)
+/* Run program with args through measure_child, which reports the
+ * program's own peak RSS (see tests/tools/measure_child.c: a child forked
+ * from this process would count this process's memory, and under valgrind
+ * or ASan that is the tool's).  fsize_limit > 0 sets RLIMIT_FSIZE, with
+ * SIGXFSZ ignored, so writes fail with EFBIG.  stdout and stderr are
+ * captured. */
+static run_result run_measured(const char *program, const char *const *args, long fsize_limit)
 {
     run_result r;
-    const char *cmd[40];
-    char fdarg[16];
-    int out[2], err[2], rep[2], st, n = 0;
-    pid_t pid;
-    double t0 = now_s();
+    tp_opts opts = { .fsize_limit = fsize_limit, .measure_memory = 1 };
+    tp_result t;
 
     memset(&r, 0, sizeof r);
     r.status = -1;
     r.peak_kb = -1;
-    if (pipe(out) != 0)
+    if (tp_run(program, args, &opts, &t) != 0)
         return r;
-    if (pipe(err) != 0) {
-        close(out[0]);
-        close(out[1]);
-        return r;
-    }
-    if (pipe(rep) != 0) {
-        close(out[0]);
-        close(out[1]);
-        close(err[0]);
-        close(err[1]);
-        return r;
-    }
-    snprintf(fdarg, sizeof fdarg, "%d", rep[1]);
-    cmd[n++] = MEASURE_CHILD;
-    cmd[n++] = fdarg;
-    for (int i = 0; argv[i] && n < 39; i++)
-        cmd[n++] = argv[i];
-    cmd[n] = NULL;
-    fflush(stdout);
-    fflush(stderr);
-    pid = fork();
-    if (pid == 0) {
-        close(out[0]);
-        close(err[0]);
-        close(rep[0]);
-        if (dup2(out[1], 1) < 0 || dup2(err[1], 2) < 0)
-            _exit(126);
-        if (fsize_limit > 0) {
-            struct rlimit rl = { (rlim_t)fsize_limit, (rlim_t)fsize_limit };
-            signal(SIGXFSZ, SIG_IGN);
-            if (setrlimit(RLIMIT_FSIZE, &rl) != 0)
-                _exit(125);
-        }
-        execv(MEASURE_CHILD, (char *const *)cmd);
-        _exit(127);
-    }
-    close(out[1]);
-    close(err[1]);
-    close(rep[1]);
-    if (pid < 0) {
-        close(out[0]);
-        close(err[0]);
-        close(rep[0]);
-        return r;
-    }
-    {
-        struct pollfd pf[2] = { { out[0], POLLIN, 0 }, { err[0], POLLIN, 0 } };
-        int open_fds = 2;
-        while (open_fds > 0) {
-            if (poll(pf, 2, -1) < 0) {
-                if (errno == EINTR)
-                    continue;
-                break;
-            }
-            for (int k = 0; k < 2; k++) {
-                if (pf[k].fd >= 0 && (pf[k].revents & (POLLIN | POLLHUP | POLLERR)) &&
-                    !drain(pf[k].fd, k ? r.err : r.out, k ? sizeof r.err : sizeof r.out)) {
-                    pf[k].fd = -1;
-                    open_fds--;
-                }
-            }
-        }
-    }
-    close(out[0]);
-    close(err[0]);
-    while (waitpid(pid, &st, 0) < 0) {
-        if (errno != EINTR) {
-            close(rep[0]);
-            return r;
-        }
-    }
-    r.seconds = now_s() - t0;
-    {
-        char line[128] = "";
-        int status;
-        long kb;
-        while (drain(rep[0], line, sizeof line))
-            ;
-        if (WIFEXITED(st) && WEXITSTATUS(st) == 0 &&
-            sscanf(line, "status %d peak_kb %ld", &status, &kb) == 2) {
-            r.status = status;
-            r.peak_kb = kb;
-        }
-    }
-    close(rep[0]);
+    r.status = t.status;
+    r.peak_kb = t.peak_kb;
+    r.seconds = t.seconds;
+    snprintf(r.out, sizeof r.out, "%s", t.out);
+    snprintf(r.err, sizeof r.err, "%s", t.err);
+    tp_result_free(&t);
     return r;
 }
-
 
 /* ---- 10^6 objects ------------------------------------------------------- */
 
@@ -664,13 +558,13 @@ static long parse_many_measured(const char *item, long count, size_t max_objects
                                 size_t msg_size, long *objects, double *seconds)
 {
     char cnt[32], lim[32];
-    const char *argv[] = { PARSE_MANY, item, cnt, lim, NULL };
+    const char *args[] = { item, cnt, lim, NULL };
     run_result r;
     char *nl;
 
     snprintf(cnt, sizeof cnt, "%ld", count);
     snprintf(lim, sizeof lim, "%zu", max_objects);
-    r = run_measured(argv, 0);
+    r = run_measured(PARSE_MANY, args, 0);
     *seconds = r.seconds;
     *objects = -1;
     msg[0] = '\0';
@@ -848,13 +742,7 @@ static void test_junk(void)
 
 static run_result run_lensrender(const char *const *args, long fsize_limit)
 {
-    const char *argv[32];
-    int n = 0;
-    argv[n++] = LENSRENDER;
-    for (int i = 0; args[i] && n < 31; i++)
-        argv[n++] = args[i];
-    argv[n] = NULL;
-    return run_measured(argv, fsize_limit);
+    return run_measured(LENSRENDER, args, fsize_limit);
 }
 
 static int one_line(const char *s)

@@ -23,11 +23,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/types.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "check.h"
+#include "subprocess.h"
 
 #ifndef LP_BIN_DIR
 #error "LP_BIN_DIR must name the directory of the built programs"
@@ -74,57 +73,17 @@ static char *slurp_file(FILE *f, size_t *len)
 static proc run_argv(const char *const *args)
 {
     proc p;
-    const char *argv[64];
-    size_t n = 0;
-    FILE *fo = tmpfile(), *fe = tmpfile();
-    pid_t pid;
-    int st;
+    tp_result r;
 
     memset(&p, 0, sizeof p);
-    p.status = -1;
-    argv[n++] = LENSRENDER;
-    snprintf(p.what, sizeof p.what, "lensrender");
-    for (size_t i = 0; args[i] && n < 63; i++) {
-        size_t l = strlen(p.what);
-        argv[n++] = args[i];
-        snprintf(p.what + l, sizeof p.what - l, " '%s'", args[i]);
-    }
-    argv[n] = NULL;
-    if (!fo || !fe) {
-        fprintf(stderr, "tmpfile: %s\n", strerror(errno));
+    tp_describe(LENSRENDER, args, p.what, sizeof p.what);
+    if (tp_run(LENSRENDER, args, NULL, &r) != 0) {
+        fprintf(stderr, "%s: %s\n", p.what, r.error);
         exit(1);
     }
-    fflush(stdout);
-    fflush(stderr);
-    pid = fork();
-    if (pid < 0) {
-        fprintf(stderr, "fork: %s\n", strerror(errno));
-        exit(1);
-    }
-    if (pid == 0) {
-        if (dup2(fileno(fo), 1) < 0 || dup2(fileno(fe), 2) < 0)
-            _exit(126);
-        execv(LENSRENDER, (char *const *)argv);
-        _exit(127);
-    }
-    while (waitpid(pid, &st, 0) < 0) {
-        if (errno != EINTR) {
-            fprintf(stderr, "waitpid: %s\n", strerror(errno));
-            exit(1);
-        }
-    }
-    if (WIFEXITED(st))
-        p.status = WEXITSTATUS(st);
-    else if (WIFSIGNALED(st))
-        p.status = 128 + WTERMSIG(st);
-    p.out = slurp_file(fo, NULL);
-    p.err = slurp_file(fe, NULL);
-    fclose(fo);
-    fclose(fe);
-    if (!p.out || !p.err) {
-        fprintf(stderr, "reading the output of %s failed\n", p.what);
-        exit(1);
-    }
+    p.status = r.status;
+    p.out = r.out;
+    p.err = r.err;
     return p;
 }
 
