@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include "subprocess.h"
+#include "test_files.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -14,7 +15,6 @@
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
 
 #ifndef LP_BIN_DIR
@@ -22,13 +22,6 @@
 #endif
 
 static const char *const MEASURE_CHILD = LP_BIN_DIR "/measure_child";
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 /* Records why tp_run failed (with errno's text); returns -1. */
 static int fail(tp_result *r, const char *what)
@@ -144,7 +137,7 @@ int tp_run(const char *program, const char *const args[], const tp_opts *opts, t
 
     fflush(stdout);
     fflush(stderr);
-    t0 = now_s();
+    t0 = tf_now();
     pid = fork();
     if (pid < 0) {
         fail(r, "fork");
@@ -158,7 +151,7 @@ int tp_run(const char *program, const char *const args[], const tp_opts *opts, t
             goto done;
         }
     }
-    r->seconds = now_s() - t0;
+    r->seconds = tf_now() - t0;
     status = WIFEXITED(st) ? WEXITSTATUS(st) : WIFSIGNALED(st) ? 128 + WTERMSIG(st) : -1;
     if (opts->measure_memory) {
         /* "status S peak_kb K" when measure_child ran and reported (exit 0) */

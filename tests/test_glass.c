@@ -11,6 +11,7 @@
 
 #include "check.h"
 #include "lensprim.h"
+#include "test_files.h"
 
 #ifndef LP_TEST_TMP
 #define LP_TEST_TMP "."
@@ -31,16 +32,6 @@ static double abbe(const lp_glass *g)
 {
     double nd = lp_glass_index(g, LAMBDA_D);
     return (nd - 1.0) / (lp_glass_index(g, LAMBDA_F) - lp_glass_index(g, LAMBDA_C));
-}
-
-static int write_file(const char *path, const void *data, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    size_t put;
-    if (!f)
-        return 0;
-    put = fwrite(data, 1, n, f);
-    return fclose(f) == 0 && put == n;
 }
 
 /* Field-by-field equality of two glasses (no padding compared). */
@@ -520,7 +511,7 @@ static void test_agf_file(void)
         return;
     }
 
-    CHECK(write_file(path, agf_text, n), "write %s", path);
+    CHECK(tf_write(path, agf_text, n) == 0, "write %s", path);
     CHECK(lp_catalog_load_agf(cat, path, &err) == LP_OK && err.status == LP_OK,
           "load %s: %s", path, err.message);
     check_test_catalog(cat, "CRLF file");
@@ -534,7 +525,7 @@ static void test_agf_file(void)
             u16[2 + 2 * i] = (unsigned char)agf_text[i];
             u16[3 + 2 * i] = 0;
         }
-        CHECK(write_file(path16, u16, 2 * n + 2), "write %s", path16);
+        CHECK(tf_write(path16, u16, 2 * n + 2) == 0, "write %s", path16);
         CHECK(lp_catalog_load_agf(cat16, path16, &err) == LP_OK,
               "load UTF-16LE: %s", err.message);
         check_test_catalog(cat16, "UTF-16LE file");

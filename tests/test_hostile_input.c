@@ -28,11 +28,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <dirent.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "check.h"
 #include "subprocess.h"
+#include "test_files.h"
 
 #include "../lensprim/tools/lenstrace_args.c"
 
@@ -50,42 +50,6 @@ static void regression_dir(char *out, size_t n, const char *target)
         snprintf(out, n, "%.*s/regressions/%s", (int)(slash - __FILE__), __FILE__, target);
     else
         snprintf(out, n, "regressions/%s", target);
-}
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static unsigned char *read_file(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    unsigned char *buf = NULL;
-    size_t n = 0, cap = 0;
-    if (!f)
-        return NULL;
-    for (;;) {
-        size_t got;
-        if (n == cap) {
-            unsigned char *nb = realloc(buf, cap ? 2 * cap : 4096);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return NULL;
-            }
-            buf = nb;
-            cap = cap ? 2 * cap : 4096;
-        }
-        got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    fclose(f);
-    *len = n;
-    return buf;
 }
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
@@ -283,7 +247,7 @@ static void test_args_regressions(void)
         if (!is_regular_entry(e))
             continue;
         snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        data = read_file(path, &len);
+        data = (unsigned char *)tf_read(path, &len);
         CHECK(data != NULL, "cannot read %s", path);
         if (!data)
             continue;
@@ -659,7 +623,7 @@ static void test_agf_regressions(void)
         if (!is_regular_entry(e))
             continue;
         snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        data = read_file(path, &len);
+        data = (unsigned char *)tf_read(path, &len);
         CHECK(data != NULL, "cannot read %s", path);
         if (!data)
             continue;
@@ -786,7 +750,7 @@ static void test_hostile_agf(void)
     {
         size_t n = 100000, cap = 64 + n * 40, len = 0;
         char *t = malloc(cap);
-        double t0 = now_s();
+        double t0 = tf_now();
         if (!t)
             abort();
         len += (size_t)snprintf(t + len, cap - len,
@@ -796,8 +760,8 @@ static void test_hostile_agf(void)
                                     0.3 + 2.2 * (double)rnd() / 18446744073709551616.0,
                                     0.5 + 0.5 * (double)(i % 97) / 97.0);
         CHECK(agf_checked(t, len, "10^5 IT lines") == LP_OK, "10^5 IT lines refused");
-        CHECK(now_s() - t0 < 20.0, "10^5 IT lines took %.1f s", now_s() - t0);
-        printf("agf: 10^5 IT lines loaded in %.2f s\n", now_s() - t0);
+        CHECK(tf_now() - t0 < 20.0, "10^5 IT lines took %.1f s", tf_now() - t0);
+        printf("agf: 10^5 IT lines loaded in %.2f s\n", tf_now() - t0);
         /* 10^4 glasses load; 10^5 are refused at the 20,000th (the
          * catalog searches names linearly: no quadratic hang) */
         for (size_t count = 10000; count <= 100000; count *= 10) {
@@ -805,7 +769,7 @@ static void test_hostile_agf(void)
             lp_error err;
             lp_status st = LP_ERROR_NO_MEMORY;
             len = 0;
-            t0 = now_s();
+            t0 = tf_now();
             for (size_t i = 0; i < count && len + 80 < cap; i++)
                 len += (size_t)snprintf(t + len, cap - len,
                                         "NM G%zu 5 0 1.5 60\nCD 1.5 0.01 0\n", i);
@@ -824,9 +788,9 @@ static void test_hostile_agf(void)
             else
                 CHECK(st != LP_OK && strstr(err.message, "line 40001: more than 20000 glasses"),
                       "10^5 glasses: '%s'", err.message);
-            CHECK(now_s() - t0 < 20.0, "%zu glasses took %.1f s", count, now_s() - t0);
+            CHECK(tf_now() - t0 < 20.0, "%zu glasses took %.1f s", count, tf_now() - t0);
             printf("agf: %zu glasses: %s in %.2f s\n", count, st == LP_OK ? "loaded" : "refused",
-                   now_s() - t0);
+                   tf_now() - t0);
         }
         free(t);
     }

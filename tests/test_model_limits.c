@@ -55,6 +55,7 @@
 
 #include "check.h"
 #include "subprocess.h"
+#include "test_files.h"
 #include "lensprim.h"
 
 #ifndef LP_BIN_DIR
@@ -699,28 +700,6 @@ static void check_skew(void)
 /* 6: the command                                                      */
 /* ------------------------------------------------------------------ */
 
-static char *read_file(const char *path, long *size)
-{
-    FILE *f = fopen(path, "rb");
-    char *s = NULL;
-    long n;
-    if (!f)
-        return NULL;
-    if (fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0) {
-        s = malloc((size_t)n + 1);
-        if (s && fread(s, 1, (size_t)n, f) != (size_t)n) {
-            free(s);
-            s = NULL;
-        } else if (s) {
-            s[n] = '\0';
-            if (size)
-                *size = n;
-        }
-    }
-    fclose(f);
-    return s;
-}
-
 /* Run the tool with argv[1..] = args (NULL-terminated).  When it cannot
  * be run: status -1, out and err NULL. */
 static tp_result run_tool(const char *const *args)
@@ -741,7 +720,7 @@ typedef struct table {
 static int table_read(const char *path, table *t)
 {
     memset(t, 0, sizeof *t);
-    t->text = read_file(path, NULL);
+    t->text = tf_read(path, NULL);
     if (!t->text)
         return -1;
     int lines = 0;
@@ -829,9 +808,10 @@ static double num(const table *t, int r, int c)
 static void check_png(const char *dir, const char *name)
 {
     char path[512];
-    long size = 0;
+    size_t len = 0;
     snprintf(path, sizeof path, "%s/%s", dir, name);
-    char *s = read_file(path, &size);
+    char *s = tf_read(path, &len);
+    long size = (long)len;
     CHECK(s != NULL, "%s exists", path);
     if (!s)
         return;

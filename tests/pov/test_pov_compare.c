@@ -28,6 +28,7 @@
 
 #include "check.h"
 #include "subprocess.h"
+#include "test_files.h"
 #include "compare.h"
 #include "povray.h"
 
@@ -305,26 +306,6 @@ static double jnum(const jv *root, const char *path, int null_is_inf)
     return NAN;
 }
 
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    char *s = NULL;
-    long n;
-    if (!f)
-        return NULL;
-    if (fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0 &&
-        (s = malloc((size_t)n + 1)) != NULL) {
-        if (fread(s, 1, (size_t)n, f) != (size_t)n) {
-            free(s);
-            s = NULL;
-        } else {
-            s[n] = '\0';
-        }
-    }
-    fclose(f);
-    return s;
-}
-
 /* ---- running pov_compare -------------------------------------------- */
 
 static int count_lines(const char *s)
@@ -445,7 +426,7 @@ static void check_scene(const char *file)
     snprintf(dir, sizeof dir, "%s/%s", OUT, name);
 
     snprintf(path, sizeof path, "%s/report.json", dir);
-    char *text = read_text(path);
+    char *text = tf_read(path, NULL);
     CHECK(text != NULL, "%s: no report.json at %s", file, path);
     if (!text)
         return;

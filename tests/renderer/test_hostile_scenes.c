@@ -34,11 +34,11 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "check.h"
 #include "subprocess.h"
+#include "test_files.h"
 
 #include "args.h"
 #include "parser.h"
@@ -78,52 +78,6 @@ static const char *const SCENES = LP_SOURCE_DIR "/scenes";
 #define REFUSED_RUN_PEAK_MB (UNDER_ASAN ? 256 : 64)
 
 /* ---- helpers ------------------------------------------------------------ */
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static unsigned char *read_file(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    unsigned char *buf = NULL;
-    size_t n = 0, cap = 0;
-    if (!f)
-        return NULL;
-    for (;;) {
-        size_t got;
-        if (n == cap) {
-            unsigned char *nb = realloc(buf, cap ? 2 * cap : 4096);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                return NULL;
-            }
-            buf = nb;
-            cap = cap ? 2 * cap : 4096;
-        }
-        got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0)
-            break;
-    }
-    fclose(f);
-    *len = n;
-    return buf;
-}
-
-static int write_file(const char *path, const void *data, size_t len)
-{
-    FILE *f = fopen(path, "wb");
-    int ok;
-    if (!f)
-        return -1;
-    ok = fwrite(data, 1, len, f) == len;
-    return (fclose(f) == 0 && ok) ? 0 : -1;
-}
 
 /* 1 when msg is "NAME:LINE:COL: text" with 1 <= LINE <= max_line and
  * COL >= 1 (max_line 0: any). */
@@ -295,7 +249,7 @@ static void test_regressions(void)
         if (e->d_name[0] == '.' || strcmp(e->d_name, "README.md") == 0)
             continue;
         snprintf(path, sizeof path, "%s/%s", REGRESSIONS, e->d_name);
-        data = read_file(path, &len);
+        data = (unsigned char *)tf_read(path, &len);
         CHECK(data != NULL, "cannot read %s", path);
         if (!data)
             continue;
@@ -489,10 +443,10 @@ static void test_nesting(void)
     };
     for (size_t i = 0; i < sizeof deep / sizeof deep[0]; i++) {
         char *s = nest(deep[i].pre, deep[i].open, deep[i].mid, deep[i].close, deep[i].post);
-        double t0 = now_s();
+        double t0 = tf_now();
         refused(s, deep[i].want);
-        CHECK(now_s() - t0 < 10.0, "nesting '%s' x %d took %.1f s", deep[i].open, DEEP,
-              now_s() - t0);
+        CHECK(tf_now() - t0 < 10.0, "nesting '%s' x %d took %.1f s", deep[i].open, DEEP,
+              tf_now() - t0);
         free(s);
     }
     refused("sphere { 0, 1 } \"abc", "unterminated string");
@@ -638,7 +592,7 @@ static void test_truncations(void)
         if (nl < 7 || strcmp(e->d_name + nl - 6, ".scene") != 0)
             continue;
         snprintf(path, sizeof path, "%s/%s", SCENES, e->d_name);
-        data = read_file(path, &len);
+        data = (unsigned char *)tf_read(path, &len);
         CHECK(data != NULL, "cannot read %s", path);
         if (!data)
             continue;
@@ -700,7 +654,7 @@ static void test_junk(void)
         buf[len] = '\0';
         parse_checked((const char *)buf, strlen((const char *)buf), "junk.scene", "junk");
         /* from a file, with its NULs */
-        if (write_file(path, buf, len) != 0) {
+        if (tf_write(path, buf, len) != 0) {
             CHECK(0, "cannot write %s", path);
             break;
         }
@@ -712,7 +666,7 @@ static void test_junk(void)
     /* a NUL in the middle of a valid scene read from a file */
     {
         static const char nul[] = "sphere { 0, 1 }\n\0sphere { 0, 1 }\n";
-        write_file(path, nul, sizeof nul - 1);
+        tf_write(path, nul, sizeof nul - 1);
         rs_scene_init(&scene);
         CHECK(rs_parse_file(path, NULL, &scene, msg, sizeof msg) != 0 &&
                   has_location(msg, path, 2) && strstr(msg, "0x00") != NULL,
@@ -722,13 +676,13 @@ static void test_junk(void)
     remove(path);
     /* an endless file: refused after 64 MiB, not read into memory forever */
     {
-        double t0 = now_s();
+        double t0 = tf_now();
         rs_scene_init(&scene);
         CHECK(rs_parse_file("/dev/zero", NULL, &scene, msg, sizeof msg) != 0 &&
                   strstr(msg, "larger than 64 MiB") != NULL && has_location(msg, "/dev/zero", 1),
               "/dev/zero: '%s'", msg);
         rs_scene_free(&scene);
-        CHECK(now_s() - t0 < 30.0, "/dev/zero took %.1f s", now_s() - t0);
+        CHECK(tf_now() - t0 < 30.0, "/dev/zero took %.1f s", tf_now() - t0);
     }
     /* a directory */
     rs_scene_init(&scene);
@@ -827,7 +781,7 @@ static void test_atomic_output(void)
 
     r = run_lensrender(render, 0);
     CHECK(r.status == 0, "the good render failed (%d): %s", r.status, r.err);
-    good = read_file(out, &good_len);
+    good = (unsigned char *)tf_read(out, &good_len);
     CHECK(good != NULL && good_len > 200, "no good PNG at %s", out);
     if (!good || good_len <= 200) {
         free(good);
@@ -839,7 +793,7 @@ static void test_atomic_output(void)
     CHECK(r.status != 0 && r.status < 128, "a render that cannot write its PNG: exit %d (%s)",
           r.status, r.err);
     CHECK(strstr(r.err, "out.png") != NULL, "the write failure names no file: %s", r.err);
-    after = read_file(out, &after_len);
+    after = (unsigned char *)tf_read(out, &after_len);
     CHECK(after != NULL && after_len == good_len && memcmp(after, good, good_len) == 0,
           "a failed PNG write changed %s (%zu bytes, was %zu)", out, after_len, good_len);
     free(after);
@@ -847,13 +801,13 @@ static void test_atomic_output(void)
     /* a hostile scene aimed at the same output */
     {
         char *deep = nest("sphere { 0, ", "(", "1", ")", " }");
-        write_file(bad_scene, deep, strlen(deep));
+        tf_write(bad_scene, deep, strlen(deep));
         free(deep);
     }
     r = run_lensrender(broken, 0);
     CHECK(r.status == 2 && one_line(r.err) && strstr(r.err, "nesting deeper than") != NULL,
           "a deeply nested scene: exit %d, stderr '%s'", r.status, r.err);
-    after = read_file(out, &after_len);
+    after = (unsigned char *)tf_read(out, &after_len);
     CHECK(after != NULL && after_len == good_len && memcmp(after, good, good_len) == 0,
           "a refused scene changed %s", out);
     free(after);

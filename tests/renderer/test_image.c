@@ -41,31 +41,13 @@
 #include "check.h"
 #include "image.h"
 #include "spectrum.h"
+#include "test_files.h"
 
 static char tmpdir[1024];
 
 static void path_in(char *buf, size_t n, const char *name)
 {
     snprintf(buf, n, "%s/%s", tmpdir, name);
-}
-
-static unsigned char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    unsigned char *buf = NULL;
-    long n;
-
-    *len = 0;
-    if (!f)
-        return NULL;
-    if (fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) >= 0
-        && fseek(f, 0, SEEK_SET) == 0) {
-        buf = malloc((size_t)n + 1);
-        if (buf && fread(buf, 1, (size_t)n, f) == (size_t)n)
-            *len = (size_t)n;
-    }
-    fclose(f);
-    return buf;
 }
 
 static void spit(const char *path, const void *data, size_t len)
@@ -135,7 +117,7 @@ static void test_png8(void)
     rs_image_free(&back);
 
     /* The chunks. */
-    buf = slurp(path, &len);
+    buf = (unsigned char *)tf_read(path, &len);
     CHECK(buf && len > 8 && memcmp(buf, "\x89PNG\r\n\x1a\n", 8) == 0, "PNG signature");
     if (buf) {
         at = find_chunk(buf, len, "sRGB");
@@ -202,7 +184,7 @@ static void test_png16(void)
         for (size_t i = 0; i < 13 * 9 * 3; i++)
             CHECK_ABS(back.rgb[i], img.rgb[i], 0.5 / 65535.0 + 1e-7, "16-bit value %zu", i);
     rs_image_free(&back);
-    buf = slurp(path, &len);
+    buf = (unsigned char *)tf_read(path, &len);
     if (buf) {
         long at = find_chunk(buf, len, "gAMA");
         CHECK(at >= 0 && (size_t)at + 8 <= len, "no gAMA in the 16-bit file");
@@ -348,7 +330,7 @@ static void test_png_read_types(void)
         path_in(path, sizeof path, "missing.png");
         CHECK(rs_png_read(path, &im, NULL, msg, sizeof msg) != 0, "missing file read");
         path_in(path, sizeof path, "ramp.png");
-        buf = slurp(path, &len);
+        buf = (unsigned char *)tf_read(path, &len);
         if (buf) {
             path_in(path, sizeof path, "truncated.png");
             spit(path, buf, len / 2);
@@ -392,7 +374,7 @@ static void test_atomic(void)
     CHECK(msg[0] != '\0', "no message");
     CHECK(rs_pfm_write(path, &img, msg, sizeof msg) != 0, "PFM with the temp path blocked");
     CHECK(rs_png_write16_linear(path, &img, msg, sizeof msg) != 0, "16-bit with the temp path blocked");
-    before = slurp(path, &nb);
+    before = (unsigned char *)tf_read(path, &nb);
     CHECK(before && nb == 21 && memcmp(before, "precious old contents", 21) == 0,
           "the existing file was clobbered");
     free(before);
@@ -401,7 +383,7 @@ static void test_atomic(void)
 
     /* Now it works and replaces the file. */
     CHECK(rs_png_write(path, &img, msg, sizeof msg) == 0, "overwrite keep.png: %s", msg);
-    after = slurp(path, &na);
+    after = (unsigned char *)tf_read(path, &na);
     CHECK(after && na > 8 && memcmp(after, "\x89PNG", 4) == 0, "keep.png replaced by a PNG");
     free(after);
     CHECK(stat(tmp, &st) != 0, "temporary file left behind");
@@ -422,7 +404,7 @@ static void test_atomic(void)
             seed = seed * 1664525u + 1013904223u;
             big.rgb[i] = (float)((seed >> 8) / 16777216.0);
         }
-        before = slurp(path, &nb);
+        before = (unsigned char *)tf_read(path, &nb);
         signal(SIGXFSZ, SIG_IGN);
         CHECK(getrlimit(RLIMIT_FSIZE, &old) == 0, "getrlimit");
         small = old;
@@ -435,7 +417,7 @@ static void test_atomic(void)
         printf("file size limit, PFM: %s\n", msg);
         CHECK(setrlimit(RLIMIT_FSIZE, &old) == 0, "restore the file size limit");
         signal(SIGXFSZ, SIG_DFL);
-        after = slurp(path, &na);
+        after = (unsigned char *)tf_read(path, &na);
         CHECK(before && after && na == nb && memcmp(after, before, na) == 0,
               "a failed write changed the file");
         CHECK(stat(tmp, &st) != 0, "temporary file left after a failed write");
@@ -447,10 +429,10 @@ static void test_atomic(void)
     /* An empty image is refused without touching anything. */
     {
         rs_image empty = {0, 0, NULL};
-        after = slurp(path, &na);
+        after = (unsigned char *)tf_read(path, &na);
         CHECK(rs_png_write(path, &empty, msg, sizeof msg) != 0, "empty image written");
         CHECK(rs_pfm_write(path, &empty, msg, sizeof msg) != 0, "empty image written as PFM");
-        before = slurp(path, &nb);
+        before = (unsigned char *)tf_read(path, &nb);
         CHECK(after && before && na == nb && memcmp(after, before, na) == 0,
               "a refused write changed the file");
         free(after);
@@ -498,7 +480,7 @@ static void test_pfm(void)
                   (unsigned)float_bits(img.rgb[i]));
     rs_image_free(&back);
 
-    buf = slurp(path, &len);
+    buf = (unsigned char *)tf_read(path, &len);
     CHECK(buf && len == 12 + 45 * 4, "PFM file length %zu", len);
     if (buf && len == 12 + 45 * 4) {
         /* 0.125f = 0x3e000000, little-endian, first value of the file. */
