@@ -185,6 +185,7 @@ static void test_png16(void)
             CHECK_ABS(back.rgb[i], img.rgb[i], 0.5 / 65535.0 + 1e-7, "16-bit value %zu", i);
     rs_image_free(&back);
     buf = (unsigned char *)tf_read(path, &len);
+    CHECK(buf != NULL, "cannot read back %s", path);
     if (buf) {
         long at = find_chunk(buf, len, "gAMA");
         CHECK(at >= 0 && (size_t)at + 8 <= len, "no gAMA in the 16-bit file");
@@ -331,6 +332,7 @@ static void test_png_read_types(void)
         CHECK(rs_png_read(path, &im, NULL, msg, sizeof msg) != 0, "missing file read");
         path_in(path, sizeof path, "ramp.png");
         buf = (unsigned char *)tf_read(path, &len);
+        CHECK(buf != NULL, "cannot read %s", path);
         if (buf) {
             path_in(path, sizeof path, "truncated.png");
             spit(path, buf, len / 2);
