@@ -87,28 +87,13 @@ static ref_real sag_l(ref_real c, ref_real r)
 /* roots of A s^2 + 2 B s + C = 0, ascending */
 static int roots2(ref_real A, ref_real B, ref_real C, ref_real r[2])
 {
-    if (A == REF(0.0)) {
-        if (B == REF(0.0))
-            return 0;
-        r[0] = -C / (REF(2.0) * B);
-        return 1;
-    }
-    ref_real disc = B * B - A * C;
-    if (disc < REF(0.0))
-        return 0;
-    ref_real q = -(B + ref_copysign(ref_sqrt(disc), B));
-    if (q == REF(0.0)) {
-        r[0] = REF(0.0);
-        return 1;
-    }
-    r[0] = q / A;
-    r[1] = C / q;
-    if (r[1] < r[0]) {
+    int n = ref_quad_roots(A, B, C, r);
+    if (n == 2 && r[1] < r[0]) {
         ref_real tmp = r[0];
         r[0] = r[1];
         r[1] = tmp;
     }
-    return 2;
+    return n;
 }
 
 /* First hit of O + s d (d unit), s > smin: surface 0 front, 1 back, 2 rim,

@@ -166,27 +166,6 @@ typedef struct {
     int surf;
 } ref_hit;
 
-/* roots of A s^2 + 2 B s + C = 0 (stable form) */
-static inline int quad_roots(ref_real A, ref_real B, ref_real C, ref_real r[2])
-{
-    if (A == REF(0.0)) {
-        if (B == REF(0.0))
-            return 0;
-        r[0] = -C / (REF(2.0) * B);
-        return 1;
-    }
-    ref_real disc = B * B - A * C;
-    if (disc < REF(0.0))
-        return 0;
-    ref_real q = -(B + ref_copysign(ref_sqrt(disc), B));
-    if (q == REF(0.0)) {
-        r[0] = REF(0.0);
-        return 1;
-    }
-    r[0] = q / A;
-    r[1] = C / q;
-    return 2;
-}
 
 static inline void consider(ref_hit *best, ref_real s, lv3 p, lv3 n, int surf)
 {
@@ -210,7 +189,7 @@ static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, ref_real sm
         ref_real A = c, B = c * (O.x * d.x + O.y * d.y + Z * d.z) - d.z;
         ref_real C = c * (O.x * O.x + O.y * O.y + Z * Z) - REF(2.0) * Z;
         ref_real r[2];
-        int nr = quad_roots(A, B, C, r);
+        int nr = ref_quad_roots(A, B, C, r);
         for (int i = 0; i < nr; i++) {
             if (!(r[i] > smin))
                 continue;
@@ -231,7 +210,7 @@ static inline ref_hit ref_intersect(const ref_lens *L, lv3 O, lv3 d, ref_real sm
         ref_real B = O.x * d.x + O.y * d.y - R0 * L->k * d.z;
         ref_real C = O.x * O.x + O.y * O.y - R0 * R0;
         ref_real r[2];
-        int nr = quad_roots(A, B, C, r);
+        int nr = ref_quad_roots(A, B, C, r);
         for (int i = 0; i < nr; i++) {
             if (!(r[i] > smin))
                 continue;

@@ -94,4 +94,28 @@ typedef long double _Complex ref_complex;
 /* pi to binary128 precision (36 digits) */
 #define REF_PI REF(3.14159265358979323846264338327950288)
 
+/* The real roots of A s^2 + 2 B s + C = 0 in the stable form (q = -(B +
+ * sign(B) sqrt(B^2 - AC)), roots q/A and C/q; the linear case when A = 0),
+ * in no particular order; returns how many (0, 1 or 2). */
+static inline int ref_quad_roots(ref_real A, ref_real B, ref_real C, ref_real r[2])
+{
+    if (A == REF(0.0)) {
+        if (B == REF(0.0))
+            return 0;
+        r[0] = -C / (REF(2.0) * B);
+        return 1;
+    }
+    ref_real disc = B * B - A * C;
+    if (disc < REF(0.0))
+        return 0;
+    ref_real q = -(B + ref_copysign(ref_sqrt(disc), B));
+    if (q == REF(0.0)) {
+        r[0] = REF(0.0);
+        return 1;
+    }
+    r[0] = q / A;
+    r[1] = C / q;
+    return 2;
+}
+
 #endif /* LP_TEST_REF_REAL_H */
