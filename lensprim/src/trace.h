@@ -30,12 +30,22 @@ typedef struct lp__payload {
     uint64_t ch;
 } lp__payload;
 
-/* Append the field E leaving the lens (local point p, local unit dir d)
- * to res as one or two linear rays.  Returns LP_ERROR_NO_MEMORY or LP_OK;
- * adds their power to res->out. */
-lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
-                   lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
-                   uint64_t path, lp_error *err);
+/* Where an outgoing ray leaves: its local unit direction d, and its world
+ * origin and direction. */
+typedef struct lp__exit {
+    lp_vec3 d;
+    lp_vec3 world_origin, world_dir;
+} lp__exit;
+
+/* Append the field E leaving the lens at x to res as one or two linear
+ * rays.  Returns LP_ERROR_NO_MEMORY or LP_OK; adds their power to
+ * res->out. */
+lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
+                   const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
+                   lp_error *err);
+
+/* x wrapped into [-pi, pi] (x itself when it lies there already). */
+double lp__wrap_phase(double x);
 
 /* Make v a unit vector perpendicular to the unit d; 0 if impossible. */
 int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out);

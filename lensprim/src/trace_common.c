@@ -83,26 +83,30 @@ int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
     return 1;
 }
 
-lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
-                   lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
-                   uint64_t path, lp_error *err)
+double lp__wrap_phase(double x)
+{
+    return fabs(x) <= LP_PI ? x : remainder(x, 2.0 * LP_PI);
+}
+
+lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
+                   const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
+                   lp_error *err)
 {
     lp__linear_part part[2];
-    int n = lp__field_split(E, d, part);
-    lp_vec3 wp = lp__to_world_point(lens, p), wd = lp__to_world_dir(lens, d);
+    int n = lp__field_split(E, x->d, part);
 
     for (int k = 0; k < n; k++) {
         lp_out_ray *o = lp__result_push(res);
         if (!o)
             return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
-        o->ray.origin = wp;
-        o->ray.dir = wd;
+        o->ray.origin = x->world_origin;
+        o->ray.dir = x->world_dir;
         o->ray.lambda_nm = pl->lambda_nm;
         o->ray.intensity = part[k].intensity;
         o->ray.vp = lp__to_world_dir(lens, part[k].vp);
         o->ray.kphi = pl->kphi;
         o->ray.op = pl->op;
-        o->ray.phase = remainder(pl->phase + part[k].phase, 2.0 * LP_PI);
+        o->ray.phase = lp__wrap_phase(pl->phase + part[k].phase);
         o->ray.ch = pl->ch;
         o->depth = depth;
         o->kind = kind;

@@ -18,19 +18,20 @@ static lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *r
                        lp_kind kind, int surface, uint64_t path, lp_error *err)
 {
     lp_branch_info info;
+    lp__exit x = {b->dir, lp__to_world_point(lens, p), lp__to_world_dir(lens, b->dir)};
     double power = cv3_norm2(b->E);
 
     info.depth = depth;
     info.kind = kind;
     info.surface = surface;
-    info.origin = lp__to_world_point(lens, p);
-    info.dir = lp__to_world_dir(lens, b->dir);
+    info.origin = x.world_origin;
+    info.dir = x.world_dir;
     info.bound = power;
     if (!lp__args_keep(a, &info)) {
         res->skipped += power;
         return LP_OK;
     }
-    return lp__emit(lens, res, &b->E, p, b->dir, pl, depth, kind, surface, path, err);
+    return lp__emit(lens, res, &b->E, &x, pl, depth, kind, surface, path, err);
 }
 
 static lp_status check_ray(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err)
@@ -118,8 +119,11 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
         }
         /* Along the segment: Beer-Lambert and the optical path. */
         if (o.alpha > 0.0) {
-            res->absorbed_glass += power * -expm1(-o.alpha * h.t);
-            E = cv3_scale(E, exp(-0.5 * o.alpha * h.t));
+            /* amplitude 1 + m, m = expm1(-alpha t / 2); absorbed power
+             * 1 - (1 + m)^2 = -m (2 + m), free of cancellation */
+            double m = expm1(-0.5 * o.alpha * h.t);
+            res->absorbed_glass += power * (-m * (2.0 + m));
+            E = cv3_scale_real(E, 1.0 + m);
         }
         pl.op += o.n_glass * h.t;
         p = h.p;
