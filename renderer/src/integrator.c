@@ -32,6 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bvh.h"
 #include "camera.h"
 #include "integrator.h"
 #include "shapes.h"
@@ -376,6 +377,25 @@ static int segment_meets_rim(const lp_lens *lens, lp_vec3 x, lp_vec3 d, double t
 
 /* Is the light at `to` visible from x?  Clear glass and polarizers cast
  * no shadow (as in POV-Ray); a lens rim and opaque objects do. */
+/* The shadow segment of visible(), and whether one object blocks it. */
+typedef struct shadow_seg {
+    const rs_scene *sc;
+    lp_vec3 x, d;
+    double eps, dist;
+} shadow_seg;
+
+static int blocks(void *ctx, int i)
+{
+    const shadow_seg *s = ctx;
+    const rs_object *o = &s->sc->objects[i];
+    rs_hit h;
+    if (o->type == RS_OBJ_POLARIZER)
+        return 0;
+    if (o->type == RS_OBJ_LENS)
+        return o->lens && segment_meets_rim(o->lens, s->x, s->d, s->eps, s->dist);
+    return rs_object_intersect(o, s->x, s->d, s->eps, s->dist, &h);
+}
+
 static int visible(const rs_scene *sc, lp_vec3 x, lp_vec3 to)
 {
     lp_vec3 d = {to.x - x.x, to.y - x.y, to.z - x.z};
@@ -383,20 +403,12 @@ static int visible(const rs_scene *sc, lp_vec3 x, lp_vec3 to)
     if (!(dist > 0.0))
         return 1;
     d = (lp_vec3){d.x / dist, d.y / dist, d.z / dist};
-    double eps = 1e-9 * (1.0 + sqrt(dot(x, x)));
-    for (size_t i = 0; i < sc->n_objects; i++) {
-        const rs_object *o = &sc->objects[i];
-        rs_hit h;
-        if (o->type == RS_OBJ_POLARIZER)
-            continue;
-        if (o->type == RS_OBJ_LENS) {
-            if (o->lens && segment_meets_rim(o->lens, x, d, eps, dist))
-                return 0;
-            continue;
-        }
-        if (rs_object_intersect(o, x, d, eps, dist, &h))
+    shadow_seg s = {sc, x, d, 1e-9 * (1.0 + sqrt(dot(x, x))), dist};
+    if (sc->bvh && rs_bvh_object_count(sc->bvh) == sc->n_objects)
+        return !rs_bvh_any(sc->bvh, x, d, s.eps, dist, blocks, &s);
+    for (size_t i = 0; i < sc->n_objects; i++)
+        if (blocks(&s, (int)i))
             return 0;
-    }
     return 1;
 }
 

@@ -7,6 +7,7 @@
  * placement in their parameters. */
 #include <math.h>
 
+#include "bvh.h"
 #include "shapes.h"
 
 static double dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
@@ -180,6 +181,8 @@ int rs_scene_intersect(const rs_scene *scene, lp_vec3 origin, lp_vec3 dir, doubl
 {
     int found = 0;
     rs_hit h;
+    if (scene->bvh && rs_bvh_object_count(scene->bvh) == scene->n_objects)
+        return rs_bvh_intersect(scene->bvh, scene, origin, dir, t_min, t_max, skip, hit);
     for (size_t i = 0; i < scene->n_objects; i++) {
         if ((int)i == skip)
             continue;
