@@ -35,6 +35,7 @@
 #include "bvh.h"
 #include "camera.h"
 #include "integrator.h"
+#include "packet.h"
 #include "shapes.h"
 #include "spectrum.h"
 
@@ -68,17 +69,28 @@ struct rs_integrator {
     rs_color *light_rgb;        /* per light: its colour in the rgb mode (a
                                    line's or black body's own colour) */
     double correction[3][3];    /* C^-1: makes every RGB emitter exact */
+    band *lanes;                /* a pixel's bands: the rgb mode's three
+                                   channels, or the continuum wavelengths
+                                   then the lights' lines */
+    int n_lanes;
+    rs_lane_classes *classes;   /* lanes with equal optics per lens */
 };
 
 typedef struct frame {
     lp_backward *bw;
     bundle child;
     lp_result res;
+    /* A spectral packet's split at this level (n_lanes entries each). */
+    int *lane, *pos;
+    double *val, *acc;
+    unsigned char *done;
 } frame;
 
 struct rs_worker {
     const rs_integrator *it;
     frame *frames[RS_MAX_FRAMES];
+    int *lane_all;       /* 0 .. n_lanes - 1 */
+    double *lane_value;  /* a pixel's value per lane */
     bundle pixel;
     lp_vec3 ref;     /* the pixel's phase reference point (see plane_op) */
     lp_vec3 ref_dir; /* and the direction of its camera ray */
@@ -137,6 +149,40 @@ static int invert3(const double a[3][3], double out[3][3])
             out[i][j] = (a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]) / det;
         }
     return 1;
+}
+
+/* The lanes of a pixel (see struct rs_integrator) and their classes. */
+static int make_lanes(rs_integrator *it)
+{
+    const rs_scene *sc = it->scene;
+    int n = it->opts.mode == RS_MODE_RGB ? 3 : it->opts.wavelengths;
+    if (it->opts.mode != RS_MODE_RGB)
+        for (size_t k = 0; k < sc->n_lights; k++)
+            n += sc->lights[k].spectrum.type == RS_SPECTRUM_LINE;
+    it->lanes = calloc((size_t)n, sizeof *it->lanes);
+    double *lambda = calloc((size_t)n, sizeof *lambda);
+    if (!it->lanes || !lambda) {
+        free(lambda);
+        return -1;
+    }
+    it->n_lanes = n;
+    if (it->opts.mode == RS_MODE_RGB) {
+        for (int c = 0; c < 3; c++)
+            it->lanes[c] = (band){BAND_RGB, RS_RGB_LAMBDA[c], -1, c};
+    } else {
+        int m = it->opts.wavelengths, k = 0;
+        double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / m;
+        for (; k < m; k++)
+            it->lanes[k] = (band){BAND_CONTINUUM, RS_LAMBDA_MIN + dl * (k + 0.5), -1, -1};
+        for (size_t l = 0; l < sc->n_lights; l++)
+            if (sc->lights[l].spectrum.type == RS_SPECTRUM_LINE)
+                it->lanes[k++] = (band){BAND_LINE, sc->lights[l].spectrum.line_nm, (int)l, -1};
+    }
+    for (int k = 0; k < n; k++)
+        lambda[k] = it->lanes[k].lambda;
+    int rc = rs_lane_classes_create(sc, lambda, n, &it->classes);
+    free(lambda);
+    return rc;
 }
 
 int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_integrator **out,
@@ -225,6 +271,11 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
             it->coherent[src_light(it, (int)k)] = 1;
             it->coherence[src_light(it, (int)k)] = scene->lights[k].coherence_length;
         }
+    if (make_lanes(it) != 0) {
+        rs_integrator_destroy(it);
+        snprintf(msg, msg_size, "out of memory");
+        return -1;
+    }
     *out = it;
     return 0;
 }
@@ -237,14 +288,25 @@ void rs_integrator_destroy(rs_integrator *it)
     free(it->coherence);
     free(it->light_norm);
     free(it->light_rgb);
+    free(it->lanes);
+    rs_lane_classes_destroy(it->classes);
     free(it);
 }
 
 rs_worker *rs_worker_create(const rs_integrator *it)
 {
     rs_worker *w = calloc(1, sizeof *w);
-    if (w)
-        w->it = it;
+    if (!w)
+        return NULL;
+    w->it = it;
+    w->lane_all = calloc((size_t)it->n_lanes, sizeof *w->lane_all);
+    w->lane_value = calloc((size_t)it->n_lanes, sizeof *w->lane_value);
+    if (!w->lane_all || !w->lane_value) {
+        rs_worker_destroy(w);
+        return NULL;
+    }
+    for (int k = 0; k < it->n_lanes; k++)
+        w->lane_all[k] = k;
     return w;
 }
 
@@ -258,8 +320,15 @@ void rs_worker_destroy(rs_worker *w)
         lp_backward_destroy(w->frames[f]->bw);
         free(w->frames[f]->child.r);
         lp_result_release(&w->frames[f]->res);
+        free(w->frames[f]->lane);
+        free(w->frames[f]->pos);
+        free(w->frames[f]->val);
+        free(w->frames[f]->acc);
+        free(w->frames[f]->done);
         free(w->frames[f]);
     }
+    free(w->lane_all);
+    free(w->lane_value);
     free(w->pixel.r);
     free(w);
 }
@@ -270,9 +339,21 @@ static frame *get_frame(rs_worker *w, int f)
         return NULL;
     if (!w->frames[f]) {
         frame *fr = calloc(1, sizeof *fr);
+        size_t n = (size_t)w->it->n_lanes;
         if (!fr)
             return NULL;
-        if (lp_backward_create(&fr->bw, NULL) != LP_OK) {
+        fr->lane = calloc(n, sizeof *fr->lane);
+        fr->pos = calloc(n, sizeof *fr->pos);
+        fr->val = calloc(n, sizeof *fr->val);
+        fr->acc = calloc(n, sizeof *fr->acc);
+        fr->done = calloc(n, 1);
+        if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done ||
+            lp_backward_create(&fr->bw, NULL) != LP_OK) {
+            free(fr->lane);
+            free(fr->pos);
+            free(fr->val);
+            free(fr->acc);
+            free(fr->done);
             free(fr);
             return NULL;
         }
@@ -462,45 +543,68 @@ static void emit_sum(void *ctx, int source, double radiance)
     *(double *)ctx += radiance;
 }
 
-static double trace_scalar(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level,
-                           double weight, int skip, int f)
+/* The radiance of every lane of lane[0..n) (indices of it->lanes) seen
+ * along the ray, into out[0..n).  The lanes travel as one spectral packet
+ * (packet.h) and split at a lens where their optics differ; each lane's
+ * sums are formed in the same order as if it were traced alone. */
+static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
+                         double weight, int skip, int f, double *out)
 {
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
     rs_hit h;
 
-    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h))
-        return band_emission(b, sc->background);
+    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
+        for (int k = 0; k < n; k++)
+            out[k] = band_emission(&it->lanes[lane[k]], sc->background);
+        return;
+    }
+    for (int k = 0; k < n; k++)
+        out[k] = 0.0;
     const rs_object *ob = &sc->objects[h.object];
     if (ob->type == RS_OBJ_LENS) {
-        int dT = it->max_level - level;
+        int dT = it->max_level - level, m;
         frame *fr = get_frame(w, f);
         if (dT < 1 || !fr)
-            return 0.0;
+            return;
         lp_trace_args a;
         lp_trace_args_init(&a);
         a.mode = lens_mode(it);
         a.max_depth = dT < LP_MAX_DEPTH ? dT : LP_MAX_DEPTH;
         a.min_weight = weight > 0.0 ? it->cutoff / weight : INFINITY;
-        if (lp_backward_build(fr->bw, ob->lens, o, d, b->lambda, &a, NULL) != LP_OK)
-            return 0.0;
-        size_t nq = lp_backward_query_count(fr->bw);
-        const lp_query *q = lp_backward_queries(fr->bw);
-        double sum = 0.0;
-        for (size_t k = 0; k < nq; k++)
-            sum += q[k].weight * trace_scalar(w, b, q[k].origin, q[k].dir, level + q[k].depth,
-                                              weight * q[k].weight, -1, f + 1);
-        return sum;
+        memset(fr->done, 0, (size_t)n);
+        while ((m = rs_packet_next(it->classes, h.object, lane, n, fr->done, fr->pos)) > 0) {
+            for (int k = 0; k < m; k++)
+                fr->lane[k] = lane[fr->pos[k]];
+            if (lp_backward_build(fr->bw, ob->lens, o, d, it->lanes[fr->lane[0]].lambda, &a,
+                                  NULL) != LP_OK)
+                continue;
+            size_t nq = lp_backward_query_count(fr->bw);
+            const lp_query *q = lp_backward_queries(fr->bw);
+            for (int k = 0; k < m; k++)
+                fr->acc[k] = 0.0;
+            for (size_t j = 0; j < nq; j++) {
+                trace_scalar(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
+                             weight * q[j].weight, -1, f + 1, fr->val);
+                for (int k = 0; k < m; k++)
+                    fr->acc[k] += q[j].weight * fr->val[k];
+            }
+            for (int k = 0; k < m; k++)
+                out[fr->pos[k]] = fr->acc[k];
+        }
+        return;
     }
     if (ob->type == RS_OBJ_POLARIZER) {
         /* Natural light through an ideal polarizer: half of it. */
         if (f + 1 >= RS_MAX_FRAMES)
-            return 0.0;
-        return 0.5 * trace_scalar(w, b, h.point, d, level, 0.5 * weight, h.object, f + 1);
+            return;
+        trace_scalar(w, lane, n, h.point, d, level, 0.5 * weight, h.object, f + 1, out);
+        for (int k = 0; k < n; k++)
+            out[k] = 0.5 * out[k];
+        return;
     }
-    double sum = 0.0;
-    shade(it, b, &h, emit_sum, &sum);
-    return sum;
+    for (int k = 0; k < n; k++)
+        shade(it, &it->lanes[lane[k]], &h, emit_sum, &out[k]);
 }
 
 /* ---- the polarized mode: bundles ---- */
@@ -664,11 +768,10 @@ static double bundle_power(const rs_integrator *it, const bundle *bd, double lam
     return total > 0.0 ? total : 0.0;
 }
 
+/* The polarized mode's power seen along a camera ray in one band. */
 static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
 {
     const rs_integrator *it = w->it;
-    if (it->opts.mode != RS_MODE_POLARIZED)
-        return trace_scalar(w, b, o, d, 1, 1.0, -1, 0);
     rs_hit h;
     w->pixel.n = 0;
     w->ref = rs_scene_intersect(it->scene, o, d, 0.0, INFINITY, -1, &h) ? h.point : o;
@@ -680,41 +783,37 @@ static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
 void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs_color *out)
 {
     lp_vec3 o, d;
+    double *L = w->lane_value;
     rs_camera_ray(&it->view, i + 0.5, j + 0.5, it->opts.width, it->opts.height, &o, &d);
 
+    /* Every lane's value: the unpolarized modes trace them as one packet. */
+    if (it->opts.mode != RS_MODE_POLARIZED)
+        trace_scalar(w, w->lane_all, it->n_lanes, o, d, 1, 1.0, -1, 0, L);
+    else
+        for (int k = 0; k < it->n_lanes; k++)
+            L[k] = band_value(w, &it->lanes[k], o, d);
+
     if (it->opts.mode == RS_MODE_RGB) {
-        double v[3];
-        for (int c = 0; c < 3; c++) {
-            band b = {BAND_RGB, RS_RGB_LAMBDA[c], -1, c};
-            v[c] = band_value(w, &b, o, d);
-        }
-        *out = (rs_color){v[0], v[1], v[2]};
+        *out = (rs_color){L[0], L[1], L[2]};
         return;
     }
     double xyz[3] = {0, 0, 0}, lines[3] = {0, 0, 0}, cmf[3];
     int n = it->opts.wavelengths;
     double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
     for (int k = 0; k < n; k++) {
-        double lambda = RS_LAMBDA_MIN + dl * (k + 0.5);
-        band b = {BAND_CONTINUUM, lambda, -1, -1};
-        double L = band_value(w, &b, o, d);
-        rs_cmf(lambda, cmf);
+        rs_cmf(it->lanes[k].lambda, cmf);
         for (int c = 0; c < 3; c++)
-            xyz[c] += L * cmf[c] * dl;
+            xyz[c] += L[k] * cmf[c] * dl;
     }
     /* Lines are exact deltas: no quadrature, no correction. */
-    for (size_t k = 0; k < it->scene->n_lights; k++) {
-        const rs_light *l = &it->scene->lights[k];
-        if (l->spectrum.type != RS_SPECTRUM_LINE)
-            continue;
-        band b = {BAND_LINE, l->spectrum.line_nm, (int)k, -1};
-        double L = band_value(w, &b, o, d);
+    for (int k = n; k < it->n_lanes; k++) {
+        const rs_light *l = &it->scene->lights[it->lanes[k].light];
         double lx[3];
         rs_spectrum s = l->spectrum;
         s.rgb = l->color; /* the tint of the line */
         rs_spectrum_line_xyz(&s, lx);
         for (int c = 0; c < 3; c++)
-            lines[c] += L * lx[c];
+            lines[c] += L[k] * lx[c];
     }
     rs_color raw, rl;
     rs_xyz_to_linear_srgb(xyz, &raw);
