@@ -5,7 +5,9 @@
  * so that rounding in the slab test never loses a hit the object itself
  * would report. */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "bvh.h"
 
@@ -272,13 +274,26 @@ static int slab_hit(const slab_ray *r, const bvh_node *nd, double t0, double t1)
     return 1;
 }
 
+/* nextafter(x, +infinity), inline for the common finite x > 0. */
+static double next_up(double x)
+{
+    if (!(x > 0.0) || !(x < INFINITY))
+        return nextafter(x, INFINITY);
+    uint64_t u;
+    memcpy(&u, &x, sizeof u);
+    u++;
+    memcpy(&x, &u, sizeof x);
+    return x;
+}
+
 /* Try object i against the best hit so far: a nearer hit, or an equally
  * near one of a lower index, replaces it. */
 static void try_object(const rs_scene *scene, int i, lp_vec3 origin, lp_vec3 dir, double t_min,
                        rs_hit *best, int *found)
 {
     rs_hit h;
-    double t_lim = *found ? nextafter(best->t, INFINITY) : best->t;
+    /* an equally near hit counts only for a lower index than the best's */
+    double t_lim = *found && i < best->object ? next_up(best->t) : best->t;
     if (!rs_object_intersect(&scene->objects[i], origin, dir, t_min, t_lim, &h))
         return;
     if (*found && !(h.t < best->t || (h.t == best->t && i < best->object)))
