@@ -41,7 +41,7 @@ static void box_point(double lo[3], double hi[3], lp_vec3 p)
     }
 }
 
-/* The world box of the object-space box c +- r (per axis) under xf. */
+/* The world box of the object-space box with corners a and b under xf. */
 static void xf_box(const rs_transform *xf, lp_vec3 a, lp_vec3 b, double lo[3], double hi[3])
 {
     for (int k = 0; k < 3; k++) {
@@ -62,21 +62,15 @@ int rs_object_bounds(const rs_object *o, lp_vec3 *lo_out, lp_vec3 *hi_out)
 
     switch (o->type) {
     case RS_OBJ_SPHERE:
-        c = o->u.sphere.center;
-        r = fabs(o->u.sphere.radius);
+    case RS_OBJ_DISC: /* both inside the cube of half-side r about c */
+        c = o->type == RS_OBJ_SPHERE ? o->u.sphere.center : o->u.disc.center;
+        r = fabs(o->type == RS_OBJ_SPHERE ? o->u.sphere.radius : o->u.disc.radius);
         a = (lp_vec3){c.x - r, c.y - r, c.z - r};
         b = (lp_vec3){c.x + r, c.y + r, c.z + r};
         xf_box(&o->xf, a, b, lo, hi);
         break;
     case RS_OBJ_BOX:
         xf_box(&o->xf, o->u.box.corner1, o->u.box.corner2, lo, hi);
-        break;
-    case RS_OBJ_DISC:
-        c = o->u.disc.center;
-        r = fabs(o->u.disc.radius);
-        a = (lp_vec3){c.x - r, c.y - r, c.z - r};
-        b = (lp_vec3){c.x + r, c.y + r, c.z + r};
-        xf_box(&o->xf, a, b, lo, hi);
         break;
     case RS_OBJ_POLARIZER:
         c = o->u.polarizer.center;

@@ -84,6 +84,7 @@ typedef struct frame {
     int *lane, *pos;
     double *val, *acc;
     unsigned char *done;
+    double *reach;  /* per light: light_reach memo of one shaded point */
 } frame;
 
 struct rs_worker {
@@ -325,6 +326,7 @@ void rs_worker_destroy(rs_worker *w)
         free(w->frames[f]->val);
         free(w->frames[f]->acc);
         free(w->frames[f]->done);
+        free(w->frames[f]->reach);
         free(w->frames[f]);
     }
     free(w->lane_all);
@@ -347,13 +349,15 @@ static frame *get_frame(rs_worker *w, int f)
         fr->val = calloc(n, sizeof *fr->val);
         fr->acc = calloc(n, sizeof *fr->acc);
         fr->done = calloc(n, 1);
-        if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done ||
+        fr->reach = calloc(w->it->scene->n_lights + 1, sizeof *fr->reach);
+        if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach ||
             lp_backward_create(&fr->bw, NULL) != LP_OK) {
             free(fr->lane);
             free(fr->pos);
             free(fr->val);
             free(fr->acc);
             free(fr->done);
+            free(fr->reach);
             free(fr);
             return NULL;
         }
@@ -567,7 +571,11 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
  * calls emit(source, radiance) for each non-zero source. */
 typedef void (*emit_fn)(void *ctx, int source, double radiance);
 
-static void shade(const rs_integrator *it, const band *b, const rs_hit *h, emit_fn emit, void *ctx)
+/* reach, when not NULL, holds light_reach of each light from this hit
+ * (NaN where not yet known): the lanes of a packet share their shadow
+ * rays through it. */
+static void shade(const rs_integrator *it, const band *b, const rs_hit *h, double *reach,
+                  emit_fn emit, void *ctx)
 {
     const rs_scene *sc = it->scene;
     const rs_object *o = &sc->objects[h->object];
@@ -594,7 +602,13 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, emit_
         double p = band_light(it, b, (int)k);
         if (p == 0.0)
             continue;
-        p *= light_reach(it, x, (int)k);
+        if (!reach)
+            p *= light_reach(it, x, (int)k);
+        else {
+            if (isnan(reach[k]))
+                reach[k] = light_reach(it, x, (int)k);
+            p *= reach[k];
+        }
         if (p == 0.0)
             continue;
         emit(ctx, src_light(it, (int)k), rho * c * p);
@@ -676,8 +690,12 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
             out[k] = 0.5 * out[k];
         return;
     }
+    frame *fr = get_frame(w, f);
+    if (fr)
+        for (size_t k = 0; k < sc->n_lights; k++)
+            fr->reach[k] = NAN;
     for (int k = 0; k < n; k++)
-        shade(it, &it->lanes[lane[k]], &h, emit_sum, &out[k]);
+        shade(it, &it->lanes[lane[k]], &h, fr ? fr->reach : NULL, emit_sum, &out[k]);
 }
 
 /* ---- the polarized mode: bundles ---- */
@@ -804,7 +822,7 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
         return;
     }
     emit_ctx e = {out, d, -plane_op(w, o, d)};
-    shade(it, b, &h, emit_halves, &e);
+    shade(it, b, &h, NULL, emit_halves, &e);
 }
 
 /* Power seen at the pixel.  Rays of incoherent sources add intensities;
