@@ -12,10 +12,7 @@
 #include <stddef.h>
 
 #include "lensprim.h"
-
-typedef struct rs_color {
-    double r, g, b;
-} rs_color;
+#include "support/colorimetry.h" /* rs_color */
 
 /* x_world = m * x_object + t  (m row-major 3x3), with its inverse. */
 typedef struct rs_transform {
