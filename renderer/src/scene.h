@@ -47,7 +47,7 @@ typedef struct rs_finish {
 } rs_finish;
 
 /* A spectrum of an emitter.  RGB colours become spectra by the method in
- * spectrum.h; a LINE is monochromatic (a delta of the given power). */
+ * emitter.h; a LINE is monochromatic (a delta of the given power). */
 typedef enum rs_spectrum_type {
     RS_SPECTRUM_RGB = 0,
     RS_SPECTRUM_BLACKBODY,

@@ -1,6 +1,6 @@
 /* colorimetry.c -- colour-matching functions, D65, Smits' RGB-to-spectrum
  * conversion, black bodies and linear sRGB (see colorimetry.h; the
- * emitters' spectra are in renderer/src/spectrum.c).
+ * emitters' spectra are in renderer/src/emitter.c).
  *
  * Data tables (facts, transcribed and checked as stated; the test suite
  * re-checks the published checksums):
@@ -553,7 +553,7 @@ static const double d65_table[] = {
 #define SMITS_BINS 10
 
 /* The published white spectrum is 1.0000 1.0000 0.9999 0.9993 0.9992
- * 0.9998 1.0000 1.0000 1.0000 1.0000; it is used as exactly 1 (spectrum.h).
+ * 0.9998 1.0000 1.0000 1.0000 1.0000; it is used as exactly 1 (colorimetry.h).
  * Rows in the order of the enum below. */
 enum { SM_CYAN, SM_MAGENTA, SM_YELLOW, SM_RED, SM_GREEN, SM_BLUE };
 
@@ -569,7 +569,7 @@ static const double smits_basis[6][SMITS_BINS] = {
 /* ---- Linear sRGB <-> XYZ ------------------------------------------------
  * Computed in exact rational arithmetic from the IEC 61966-2-1 primaries
  * R (0.64, 0.33), G (0.30, 0.60), B (0.15, 0.06) and the D65 white point
- * (0.3127, 0.3290), then rounded to double (spectrum.h). */
+ * (0.3127, 0.3290), then rounded to double (colorimetry.h). */
 static const double srgb_to_xyz[3][3] = {
     {0.41239079926595951, 0.35758433938387796, 0.18048078840183429},
     {0.21263900587151036, 0.71516867876775592, 0.072192315360733714},

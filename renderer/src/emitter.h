@@ -1,4 +1,4 @@
-/* spectrum.h -- the spectra of the scene's emitters and the spectral
+/* emitter.h -- the spectra of the scene's emitters and the spectral
  * estimator of the renderer's spectral modes (renderer-internal; the
  * colour tables are in support/colorimetry.h).
  *
@@ -37,8 +37,8 @@
  * (rs_spectral_normalization() = 1/K).  Colours brighter than 1 are
  * allowed: when max(r,g,b) = M > 1 the spectrum is M * reflectance(c/M),
  * so it scales linearly with the colour. */
-#ifndef RS_SPECTRUM_H
-#define RS_SPECTRUM_H
+#ifndef RS_EMITTER_H
+#define RS_EMITTER_H
 
 #include "scene.h"
 #include "support/colorimetry.h"

@@ -1,8 +1,8 @@
-/* spectrum.c -- the spectra of the scene's emitters: RGB colours as D65
- * times Smits' shape, black bodies, spectral lines (see spectrum.h). */
+/* emitter.c -- the spectra of the scene's emitters: RGB colours as D65
+ * times Smits' shape, black bodies, spectral lines (see emitter.h). */
 #include <math.h>
 
-#include "spectrum.h"
+#include "emitter.h"
 
 /* Integral over 380-780 nm of planck(T) ȳ: Simpson's rule on each 1 nm
  * interval (ȳ is linear there; the black body is smooth). */
