@@ -37,7 +37,7 @@
 #include "integrator.h"
 #include "packet.h"
 #include "shapes.h"
-#include "spectrum.h"
+#include "emitter.h"
 
 #define RS_MAX_FRAMES 400
 #define RS_PI 3.14159265358979323846
