@@ -127,7 +127,7 @@ row() {
     # The translation at a small size of the same shape (the .pov's camera
     # depends only on the aspect ratio); its renders are not used.
     "$BIN/pov_compare" "$scene" --out "$d/pc" --width "$((w / 20))" --height "$((h / 20))" \
-        --threads 1 --quiet >/dev/null 2>"$d/pc.err" || true
+        --lens-inc scenes/lens.inc --threads 1 --quiet >/dev/null 2>"$d/pc.err" || true
     [ -s "$d/pc/scene.pov" ] || {
         echo "vs_povray.sh: pov_compare wrote no scene.pov for $scene:" >&2
         cat "$d/pc.err" >&2
