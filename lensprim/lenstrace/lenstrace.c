@@ -16,6 +16,7 @@
 
 #include "lensprim.h"
 #include "lenstrace_args.h"
+#include "support/cli.h"
 
 #define EXIT_BAD 2
 
@@ -323,13 +324,7 @@ static void put_summary(outbuf *b, const totals *t, long index)
  * user text or library messages become '?'). */
 static void say(const char *prefix, const char *msg)
 {
-    char line[896];
-    snprintf(line, sizeof line, "lenstrace: %s%s", prefix ? prefix : "",
-             msg);
-    for (char *c = line; *c; c++)
-        if ((unsigned char)*c < 0x20 || *c == 0x7f)
-            *c = '?';
-    fprintf(stderr, "%s\n", line);
+    sp_say("lenstrace", "%s%s", prefix ? prefix : "", msg);
 }
 
 static const char *lib_message(const lp_error *err, lp_status st)

@@ -23,6 +23,7 @@
 
 #include "camera.h"
 #include "compare.h"
+#include "support/cli.h"
 #include "support/image.h"
 #include "integrator.h"
 #include "montage.h"
@@ -106,18 +107,7 @@ typedef struct summary {
     size_t n_notes;
 } summary;
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 1, 2)))
-#endif
-static void say(const char *fmt, ...)
-{
-    va_list ap;
-    fputs("pov_compare: ", stderr);
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fputc('\n', stderr);
-}
+#define say(...) sp_say("pov_compare", __VA_ARGS__)
 
 /* A progress line on a terminal (not with --quiet, not into files). */
 static void progress(const options *o, const char *scene, const char *stage)
@@ -125,13 +115,6 @@ static void progress(const options *o, const char *scene, const char *stage)
     if (o->quiet || !isatty(STDERR_FILENO))
         return;
     fprintf(stderr, "pov_compare: %s: %s\n", scene, stage);
-}
-
-static double now_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 /* ---- the command line ---- */
@@ -277,34 +260,6 @@ static int parse_args(int argc, char **argv, options *o)
 
 /* ---- files and directories ---- */
 
-static int mkdir_p(const char *path, char *msg, size_t msg_size)
-{
-    char buf[PATH_MAX];
-    struct stat st;
-    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) {
-        snprintf(msg, msg_size, "%s: path too long", path);
-        return -1;
-    }
-    for (char *p = buf + 1; ; p++) {
-        if (*p == '/' || *p == '\0') {
-            char c = *p;
-            *p = '\0';
-            if (mkdir(buf, 0755) != 0 && errno != EEXIST) {
-                snprintf(msg, msg_size, "%s: cannot create directory: %s", buf, strerror(errno));
-                return -1;
-            }
-            *p = c;
-            if (c == '\0')
-                break;
-        }
-    }
-    if (stat(path, &st) != 0 || !S_ISDIR(st.st_mode)) {
-        snprintf(msg, msg_size, "%s: not a directory", path);
-        return -1;
-    }
-    return 0;
-}
-
 static int is_file(const char *path)
 {
     struct stat st;
@@ -435,7 +390,7 @@ static int render_ours(const rs_scene *scene, rs_mode mode, int width, int heigh
 {
     rs_render_opts ro;
     rs_integrator *it = NULL;
-    double t0 = now_seconds();
+    double t0 = sp_now_seconds();
 
     rs_render_opts_init(&ro);
     ro.mode = mode;
@@ -455,7 +410,7 @@ static int render_ours(const rs_scene *scene, rs_mode mode, int width, int heigh
     int rc = rs_render_tiles(width, height, TILE_SIZE, threads, worker_make, worker_free,
                              render_tile, &ctx, -1);
     rs_integrator_destroy(it);
-    *seconds = now_seconds() - t0;
+    *seconds = sp_now_seconds() - t0;
     if (rc != 0) {
         rs_image_free(img);
         snprintf(msg, msg_size, "the %s render failed (out of memory for a worker thread)",
@@ -573,7 +528,7 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
         FAIL(EXIT_BAD, "%s", msg);
     if (rs_camera_setup(&st.scene.camera, w, h, &view, msg, sizeof msg) != 0)
         FAIL(EXIT_BAD, "%s: camera: %s", scene_path, msg);
-    if (mkdir_p(out_dir, msg, sizeof msg) != 0)
+    if (sp_mkdir_p(out_dir, msg, sizeof msg) != 0)
         FAIL(EXIT_BAD, "%s", msg);
 
     rep->scene = base_of(scene_path);
@@ -970,7 +925,7 @@ static int compare_all(const options *o)
             break;
     }
     if (done > 0) {
-        if (mkdir_p(out_root, msg, sizeof msg) != 0 ||
+        if (sp_mkdir_p(out_root, msg, sizeof msg) != 0 ||
             write_index(out_root, sums, done, o, msg, sizeof msg) != 0) {
             say("%s", msg);
             status = EXIT_RENDER;

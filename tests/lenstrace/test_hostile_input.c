@@ -1,6 +1,6 @@
 /* test_hostile_input.c -- hostile input to lenstrace's argument parser,
  * to the AGF catalog reader and to lp_lens_create: a clear error, never
- * a crash, a hang or unbounded memory (issue 5, item 3).
+ * a crash, a hang or unbounded memory.
  *
  *   - every input kept in tests/regressions/lenstrace_args/ (one argv word
  *     per line, as fuzz/fuzz_lenstrace_args reads them) is parsed again by

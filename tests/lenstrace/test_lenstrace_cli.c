@@ -1,5 +1,5 @@
 /* test_lenstrace_cli.c -- runs the built lenstrace binary and checks its
- * contract (docs: shared/design/interfaces.md, "lenstrace"): JSON Lines
+ * contract (docs/interfaces.md, "lenstrace"): JSON Lines
  * with the contract's keys in order, the physics of an axial ray through
  * a plano-convex N-BK7 lens (closed-form normal-incidence Fresnel), the
  * energy bookkeeping, vp=unpolarized halves, --backward, and the error
