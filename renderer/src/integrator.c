@@ -362,6 +362,25 @@ static rs_color pigment_at(const rs_pigment *p, lp_vec3 x)
     return p->color[(s & 1) ? 1 : 0];
 }
 
+/* Does the straight segment x + t d, t in (t0, t1), meet the lens's rim?
+ * A shadow ray crosses clear glass as a straight segment (POV-Ray: no
+ * refraction, no Fresnel loss), so it is blocked only where it meets the
+ * rim, from outside or from inside the glass, whatever the caps in front
+ * of it.  A lens has at most two cap crossings per cap and two rim
+ * crossings, so a handful of steps past the cap hits always ends. */
+static int segment_meets_rim(const lp_lens *lens, lp_vec3 x, lp_vec3 d, double t0, double t1)
+{
+    for (int step = 0; step < 8 && t0 < t1; step++) {
+        lp_hit h;
+        if (!lp_lens_intersect(lens, x, d, t0, t1, &h))
+            return 0;
+        if (h.surface == LP_SURFACE_RIM)
+            return 1;
+        t0 = h.t + 1e-12 * (1.0 + h.t);
+    }
+    return 0;
+}
+
 /* Is the light at `to` visible from x?  Clear glass and polarizers cast
  * no shadow (as in POV-Ray); a lens rim and opaque objects do. */
 static int visible(const rs_scene *sc, lp_vec3 x, lp_vec3 to)
@@ -377,9 +396,12 @@ static int visible(const rs_scene *sc, lp_vec3 x, lp_vec3 to)
         rs_hit h;
         if (o->type == RS_OBJ_POLARIZER)
             continue;
-        if (!rs_object_intersect(o, x, d, eps, dist, &h))
+        if (o->type == RS_OBJ_LENS) {
+            if (o->lens && segment_meets_rim(o->lens, x, d, eps, dist))
+                return 0;
             continue;
-        if (o->type != RS_OBJ_LENS || h.lens_surface == LP_SURFACE_RIM)
+        }
+        if (rs_object_intersect(o, x, d, eps, dist, &h))
             return 0;
     }
     return 1;
