@@ -753,7 +753,7 @@ static void test_rim_shadow(void)
     unsigned char mask[RS_W * RS_H];
 
     rs_scene_init(&sc);
-    if (load_scene(&sc, rim_shadow_scene, NULL, RS_W, RS_H) != 0) {
+    if (rc_load_scene(&sc, rim_shadow_scene, NULL, RS_W, RS_H) != 0) {
         CHECK(0, "rim shadow scene");
         goto out;
     }
@@ -767,7 +767,7 @@ static void test_rim_shadow(void)
             r1 = hypot(d[0] * 65.0, d[1] * 65.0);
             mask[j * RS_W + i] = r0 > RS_RIM_R + 0.5 && r1 > RS_RIM_R + 0.5;
         }
-    if (render(&sc, RS_MODE_FRESNEL, RS_W, RS_H, 0, 0.0, 4, mask, &p) != 0) {
+    if (rc_render(&sc, RS_MODE_FRESNEL, RS_W, RS_H, 0, 0.0, 4, mask, &p) != 0) {
         CHECK(0, "rim shadow render");
         goto out;
     }
@@ -793,7 +793,7 @@ static void test_rim_shadow(void)
                 dark++;
                 through_cap += hypot(xb, yb) < RS_RIM_R;
             }
-            if ((luminance_at(&p, i, j) > 0.0) == expect)
+            if ((rc_luminance(&p, i, j) > 0.0) == expect)
                 wrong++;
         }
     /* Measured: 5752 wall pixels called, 377 dark, 282 of them reached
