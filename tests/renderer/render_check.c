@@ -5,7 +5,7 @@
 #include <stdlib.h>
 
 #include "parser.h"
-#include "tiles.h"
+#include "support/tiles.h"
 
 typedef struct job {
     const rs_integrator *it;

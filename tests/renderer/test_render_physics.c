@@ -55,7 +55,7 @@
 #include "integrator.h"
 #include "render_check.h"
 #include "scene.h"
-#include "spectrum.h"
+#include "support/colorimetry.h"
 
 #define PI 3.14159265358979323846
 
