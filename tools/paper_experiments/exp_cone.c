@@ -192,11 +192,8 @@ static int figure_sections(ex_ctx *ctx, lp_lens *const *lenses,
     const int depth[4] = {4, 4, 4, 4};
     rs_image img;
     int rc = 0;
-    if (rs_image_create(&img, 1200, 900) != 0) {
-        snprintf(ctx->msg, sizeof ctx->msg, "out of memory");
+    if (ex_canvas(ctx, &img, 1200, 900) != 0)
         return -1;
-    }
-    pl_fill(&img, 0xFFFFFFu);
     for (int p = 0; p < 4 && rc == 0; p++) {
         int i = find_lens(ctx, pick[p]);
         if (i < 0)
@@ -230,11 +227,8 @@ static int figure_depth(ex_ctx *ctx, double theta[][EX_DEPTH_MAX + 1],
             ser[p][i] = (pl_series){ctx->lens[i].name, x, y[p][i], EX_DEPTH_MAX,
                                     ex_palette[i % 12], i < 12 ? PL_SOLID : PL_DASHED, 2};
     }
-    if (rs_image_create(&img, 1100, 900) != 0) {
-        snprintf(ctx->msg, sizeof ctx->msg, "out of memory");
+    if (ex_canvas(ctx, &img, 1100, 900) != 0)
         return -1;
-    }
-    pl_fill(&img, 0xFFFFFFu);
     pl_chart ch;
     memset(&ch, 0, sizeof ch);
     ch.title = "theta_K from the point on the axis two diameters in front";
@@ -296,11 +290,8 @@ static int off_axis(ex_ctx *ctx, const char *name, const lp_lens *lens, const lp
         ser[j] = (pl_series){lbl[j], px[j], py[j], N_OFF + 1, ex_palette[j], PL_SOLID, 2};
     }
     rs_image img;
-    if (rs_image_create(&img, 700, 700) != 0) {
-        snprintf(ctx->msg, sizeof ctx->msg, "out of memory");
+    if (ex_canvas(ctx, &img, 700, 700) != 0)
         return -1;
-    }
-    pl_fill(&img, 0xFFFFFFu);
     pl_chart ch;
     memset(&ch, 0, sizeof ch);
     char title[128];

@@ -128,11 +128,8 @@ int ex_shares(ex_ctx *ctx)
                                         g ? PL_DASHED : PL_SOLID, 2};
         }
     rs_image img;
-    if (rs_image_create(&img, 1000, 900) != 0) {
-        snprintf(ctx->msg, sizeof ctx->msg, "out of memory");
+    if (ex_canvas(ctx, &img, 1000, 900) != 0)
         return -1;
-    }
-    pl_fill(&img, 0xFFFFFFu);
     pl_chart ch;
     memset(&ch, 0, sizeof ch);
     ch.title = "share of the outgoing intensity by depth: light from every side";

@@ -42,6 +42,9 @@ extern const unsigned ex_palette[12];
 lp_lens *ex_make_lens(ex_ctx *ctx, double r1, double r2, double t, double d, double d2,
                       const char *glass);
 
+/* A white w x h picture to draw charts on; -1 and ctx->msg on error. */
+int ex_canvas(ex_ctx *ctx, rs_image *img, int w, int h);
+
 /* Write img as out_dir/name; -1 and ctx->msg on error. */
 int ex_save_png(ex_ctx *ctx, const char *name, const rs_image *img);
 

@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "experiments.h"
+#include "plot.h"
 #include "parser.h"
 #include "scene.h"
 
@@ -70,6 +71,16 @@ static int out_path(ex_ctx *ctx, const char *name, char *path, size_t size)
         snprintf(ctx->msg, sizeof ctx->msg, "output path too long: %s/%s", ctx->out_dir, name);
         return -1;
     }
+    return 0;
+}
+
+int ex_canvas(ex_ctx *ctx, rs_image *img, int w, int h)
+{
+    if (rs_image_create(img, w, h) != 0) {
+        snprintf(ctx->msg, sizeof ctx->msg, "out of memory for a %d x %d picture", w, h);
+        return -1;
+    }
+    pl_fill(img, 0xFFFFFFu);
     return 0;
 }
 
