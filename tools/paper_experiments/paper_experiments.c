@@ -151,7 +151,10 @@ static int load_lenses(ex_ctx *ctx, const char *dir)
         rs_scene scene;
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);
         rs_scene_init(&scene);
-        if (rs_parse_file(path, NULL, &scene, msg, sizeof msg) != 0) {
+        /* prepare: the lenses get their catalog glass (the parser keeps only
+         * the name) */
+        if (rs_parse_file(path, NULL, &scene, msg, sizeof msg) != 0 ||
+            rs_scene_prepare(&scene, msg, sizeof msg) != 0) {
             snprintf(ctx->msg, sizeof ctx->msg, "%s", msg);
             rc = -1;
         }
@@ -169,7 +172,7 @@ static int load_lenses(ex_ctx *ctx, const char *dir)
                 snprintf(l->name, sizeof l->name, "%.*s #%d", base, names[i], k);
             else
                 snprintf(l->name, sizeof l->name, "%.*s", base, names[i]);
-            l->desc = o->u.lens.desc;
+            lp_lens_get_desc(o->lens, &l->desc);
             l->desc.position = (lp_vec3){0, 0, 0};
             l->desc.axis = (lp_vec3){0, 0, 1};
             snprintf(l->glass, sizeof l->glass, "%s",
@@ -240,6 +243,19 @@ int main(int argc, char **argv)
         fprintf(stderr, "paper_experiments: missing --renders DIR (try --help)\n");
         free(ctx);
         return EXIT_USAGE;
+    }
+    static const char *const modes[4] = {"rgb", "fresnel", "polarized", "schlick"};
+    for (int m = 0; m < 4; m++) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/%s.pfm", ctx->renders, modes[m]);
+        FILE *f = fopen(path, "rb");
+        if (!f) {
+            fprintf(stderr, "paper_experiments: cannot read the render %s: %s (make it with "
+                            "lensrender --mode %s --pfm)\n", path, strerror(errno), modes[m]);
+            free(ctx);
+            return 1;
+        }
+        fclose(f);
     }
     ctx->out_dir = out;
     ctx->fig_rel = relative_to(md_path, out);
