@@ -9,7 +9,7 @@
 
 #include <stdio.h>
 
-#include "image.h"
+#include "support/image.h"
 #include "lensprim.h"
 
 #define EX_LENS_MAX 24

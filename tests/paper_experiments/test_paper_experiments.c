@@ -83,8 +83,8 @@ int main(void)
     char dir[1024], rdir[1100], out[1100], md[1100], path[1300];
     struct stat st;
     if (stat(tool, &st) != 0) {
-        printf("paper_experiments not built: skipped\n");
-        return 77;
+        fprintf(stderr, "%s is not built\n", tool);
+        return 1;
     }
     snprintf(dir, sizeof dir, "%s/paper_experiments_test", LP_TEST_TMP);
     snprintf(rdir, sizeof rdir, "%s/renders", dir);
