@@ -12,6 +12,7 @@
 set -eu
 cd "$(dirname "$0")/.."
 sh scripts/setup.sh build
+mkdir -p docs build/speed-accuracy
 build/bin/speed_accuracy --bin build/bin --scenes scenes --docs docs \
     --work build/speed-accuracy "$@"
 echo "speed_accuracy: wrote docs/speed-accuracy.csv, docs/speed-accuracy.png, docs/speed-accuracy.md"

@@ -74,22 +74,11 @@ static void say(const char *fmt, const char *a, const char *b)
     fputc('\n', stderr);
 }
 
-static int mkdir_p(const char *path)
+/* Make a directory whose parent exists (the script makes the docs and
+ * work directories). */
+static int make_dir(const char *path)
 {
-    char buf[PATH_MAX_LEN];
-    size_t n = strlen(path);
-    if (n == 0 || n >= sizeof buf)
-        return -1;
-    memcpy(buf, path, n + 1);
-    for (size_t i = 1; i <= n; i++)
-        if (buf[i] == '/' || buf[i] == '\0') {
-            char c = buf[i];
-            buf[i] = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return -1;
-            buf[i] = c;
-        }
-    return 0;
+    return mkdir(path, 0777) == 0 || errno == EEXIST ? 0 : -1;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -384,10 +373,22 @@ static int in_sweep(int m, int wl, int d, int c)
     return full || (DEPTHS[d] == 16 && c == 0) || (DEPTHS[d] == 8 && CUTOFFS[c] == 1e-3);
 }
 
+/* Render p, measure it against the reference and record it. */
+static int measure(const scene_ctx *sc, sa_point *p, sa_points *all, FILE *csv)
+{
+    rs_image img;
+    memset(&img, 0, sizeof img);
+    if (render(sc, p, sc->o->runs, &img) != 0)
+        return -1;
+    sa_error_measure(&img, &sc->ref, &p->err);
+    rs_image_free(&img);
+    snprintf(p->scene, sizeof p->scene, "%.63s", sc->name);
+    return sa_points_add(all, p) != 0 || sa_point_write_csv(csv, p) != 0 ? -1 : 0;
+}
+
 static int run_scene(scene_ctx *sc, sa_points *all, FILE *csv)
 {
     sa_point p;
-    rs_image img;
 
     if (make_reference(sc) != 0)
         return -1;
@@ -409,16 +410,10 @@ static int run_scene(scene_ctx *sc, sa_points *all, FILE *csv)
     for (size_t t = 0; t < N_OF(TOLERANCES); t++) {
         sa_point_init(&p, "auto", "auto", 0, 0, -1.0);
         p.tolerance = TOLERANCES[t];
-        memset(&img, 0, sizeof img);
-        if (render(sc, &p, sc->o->runs, &img) != 0)
+        if (measure(sc, &p, all, csv) != 0)
             return -1;
-        sa_error_measure(&img, &sc->ref, &p.err);
-        rs_image_free(&img);
-        snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
         fprintf(stderr, "speed_accuracy: %s: auto %g: %.3g s, rmse %.3g (%s)\n", sc->name,
                 p.tolerance, p.seconds, p.err.rmse, p.note);
-        if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
-            return -1;
     }
     for (size_t m = 0; m < N_OF(MODELS); m++)
         for (size_t wl = 0; wl < N_OF(WAVELENGTHS); wl++)
@@ -428,24 +423,12 @@ static int run_scene(scene_ctx *sc, sa_points *all, FILE *csv)
                         continue;
                     sa_point_init(&p, "sweep", MODELS[m], m == 3 ? 0 : WAVELENGTHS[wl],
                                   DEPTHS[d], CUTOFFS[c]);
-                    memset(&img, 0, sizeof img);
-                    if (render(sc, &p, sc->o->runs, &img) != 0)
-                        return -1;
-                    sa_error_measure(&img, &sc->ref, &p.err);
-                    rs_image_free(&img);
-                    snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
-                    if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
+                    if (measure(sc, &p, all, csv) != 0)
                         return -1;
                 }
     /* The default polarized render, for the ratio the page reports. */
     sa_point_init(&p, "default", "polarized", 0, 0, -1.0);
-    memset(&img, 0, sizeof img);
-    if (render(sc, &p, sc->o->runs, &img) != 0)
-        return -1;
-    sa_error_measure(&img, &sc->ref, &p.err);
-    rs_image_free(&img);
-    snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
-    return sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0 ? -1 : 0;
+    return measure(sc, &p, all, csv);
 }
 
 /* ---- options ---------------------------------------------------------- */
@@ -542,7 +525,7 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     sa_points_init(&all);
     snprintf(csv_path, sizeof csv_path, "%.4000s/speed-accuracy.csv", o.docs);
-    if (mkdir_p(o.docs) != 0) {
+    if (make_dir(o.docs) != 0) {
         say("%s: cannot create: %s", o.docs, strerror(errno));
         return 1;
     }
@@ -587,7 +570,7 @@ int main(int argc, char **argv)
             snprintf(path, sizeof path, "%s/%s", o.scenes, names[k]);
             sc.path = path;
             snprintf(sc.dir, sizeof sc.dir, "%.3800s/%.255s", o.work, sc.name);
-            if (mkdir_p(sc.dir) != 0) {
+            if (make_dir(sc.dir) != 0) {
                 say("%s: cannot create%s", sc.dir, "");
                 return 1;
             }
