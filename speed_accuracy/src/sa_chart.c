@@ -289,16 +289,18 @@ static const char *const PAGE_TEXT =
 "   slower than 5 s once) and takes the median CPU time (user + system of\n"
 "   the child process, from `wait4`): the machine these figures come\n"
 "   from is shared, and CPU time does not count the time other work held\n"
-"   the cores, wall time would.  Times still vary by ~10–20 % between\n"
-"   runs;\n"
+"   the cores, wall time would (with 8 engineers' work on 2 cores a\n"
+"   render's wall time was 5-25 times its CPU time);\n"
 "3. writes `speed-accuracy.csv` (every point: scene, kind, model,\n"
 "   wavelengths, depth, cut-off, tolerance, seconds, runs, rmse, largest\n"
 "   channel error, share of pixels off by more than 1/255 after the sRGB\n"
 "   curve, note), this chart and this page.\n"
 "\n"
-"The images are small (the size is in the CSV's renders: 32 × 24 by\n"
-"default) so the sweep finishes in reasonable time; errors are per\n"
-"pixel and do not depend much on size, times scale with the pixel count.\n"
+"The images are small (32 × 24 by default) so the sweep finishes in\n"
+"reasonable time; errors are per pixel and depend little on size, times\n"
+"scale with the pixel count -- except auto's probe, which has a floor of\n"
+"64 pixels and so weighs most at this size.  A scene missing from the\n"
+"chart was not swept (see the CSV).\n"
 "\n";
 
 static int write_md(const sa_points *ps, const char **names, size_t ns, const char *dir,

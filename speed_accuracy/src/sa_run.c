@@ -3,6 +3,8 @@
 
 #include "sa_run.h"
 
+#include "support/cli.h"
+
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -12,15 +14,7 @@
 #include <sys/time.h>
 #include <sys/types.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
-
-static double now(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 int sa_run(char *const argv[], const char *dir, sa_run_result *out, char *msg,
            size_t msg_size)
@@ -37,7 +31,7 @@ int sa_run(char *const argv[], const char *dir, sa_run_result *out, char *msg,
         snprintf(msg, msg_size, "cannot create a temporary file: %s", strerror(errno));
         return -1;
     }
-    t0 = now();
+    t0 = sp_now_seconds();
     pid = fork();
     if (pid < 0) {
         snprintf(msg, msg_size, "fork: %s", strerror(errno));
@@ -59,7 +53,7 @@ int sa_run(char *const argv[], const char *dir, sa_run_result *out, char *msg,
             return -1;
         }
     }
-    out->wall_seconds = now() - t0;
+    out->wall_seconds = sp_now_seconds() - t0;
     out->cpu_seconds = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec +
                        (double)ru.ru_stime.tv_sec + 1e-6 * (double)ru.ru_stime.tv_usec;
     out->status = WIFEXITED(wstatus) ? WEXITSTATUS(wstatus)
