@@ -572,7 +572,8 @@ LP_API lp_status lp_cone_compute(const lp_lens *lens, lp_vec3 point,
  * offset from the ray through the front vertex: at azimuth phi (frame as
  * above, the apex the front vertex) the largest offset rho_K such that
  * every ray at a smaller offset on that azimuth is rim-free, found as
- * theta_K is (mm). */
+ * theta_K is (mm).  Every rho_K is 0 when the ray through the front vertex
+ * is not rim-free itself (a rim-free region away from it is not sought). */
 typedef struct lp_beam_region {
     lp_cone_frame frame;
     int depth;
