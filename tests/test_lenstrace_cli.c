@@ -877,6 +877,16 @@ static void test_errors(void)
     const char *L = LENS;
     const char *Y = AXIAL;
     BAD("nan", "NaN in o", "--lens", L, "--ray", "o=0,nan,-10 d=0,0,1");
+    BAD("topaz", "unknown crystal", "--lens", "R1=0,R2=0,t=1,D=10,crystal=topaz", "--ray", Y);
+    BAD("not both", "glass and crystal", "--lens", "R1=0,R2=0,t=1,D=10,glass=N-BK7,no=1.6,ne=1.5",
+        "--ray", Y);
+    BAD("ne", "no without ne", "--lens", "R1=0,R2=0,t=1,D=10,no=1.6", "--ray", Y);
+    BAD("axis", "zero optic axis", "--lens", "R1=0,R2=0,t=1,D=10,crystal=quartz,axis=0:0:0",
+        "--ray", Y);
+    BAD("axis", "axis without a crystal", "--lens", "R1=0,R2=0,t=1,D=10,glass=N-BK7,axis=0:0:1",
+        "--ray", Y);
+    BAD("crystal", "backward through a crystal", "--lens", "R1=0,R2=0,t=1,D=10,crystal=quartz",
+        "--ray", Y, "--backward");
     BAD("d", "zero direction", "--lens", L, "--ray", "o=0,0,-10 d=0,0,0");
     BAD(NULL, "impossible lens D=60 R1=25.8", "--lens",
         "R1=25.8,R2=inf,t=5.3,D=60,glass=N-BK7", "--ray", Y);
@@ -928,6 +938,42 @@ static void test_errors(void)
         "o=0,0,-10 d=nan,0,1", "--backward");
 }
 
+/* A uniaxial crystal: an a-cut plate (axis 1:1:0 in its faces) at normal
+ * incidence splits x light into an o ray (op n_o t) and an e ray (op n_e
+ * t, "waves":1), each carrying half of T = (1 - R)^2 at depth 2.  op is
+ * printed absolute: n_air * (air-relative index) * t. */
+static void test_crystal(void)
+{
+    static output o;
+    const double no = 1.6584, ne = 1.4864, t = 0.03;
+    const double n_air = air_index(587.7247);
+    proc p = run("--lens", "R1=0,R2=0,t=0.03,D=10,no=1.6584,ne=1.4864,axis=1:1:0", "--ray",
+                 "o=0,0,-1 d=0,0,1 lambda=587.7247 vp=1,0,0", "--depth", "2",
+                 (const char *)NULL);
+    expect_success(&p, "crystal");
+    parse_output(&p, &o, "crystal");
+    check_balance(&o, "crystal");
+    int seen_o = 0, seen_e = 0;
+    for (size_t i = 0; i < o.n; i++) {
+        const rayline *r = &o.rays[i];
+        if (r->depth != 2)
+            continue;
+        double w = 0;
+        int e = jnum(r->text, "waves", &w) && w == 1;
+        double n = e ? ne : no, R = fresnel_normal(1.0, n);
+        CHECK_REL(r->op, n_air * n * t, 1e-12, "crystal: %c ray op", e ? 'e' : 'o');
+        CHECK_REL(r->I, 0.5 * (1 - R) * (1 - R), 1e-12, "crystal: %c ray I", e ? 'e' : 'o');
+        seen_e += e;
+        seen_o += !e;
+    }
+    CHECK(seen_o == 1 && seen_e == 1, "crystal: one o and one e ray (%d, %d)", seen_o, seen_e);
+    proc_free(&p);
+    p = run("--lens", "R1=0,R2=0,t=0.03,D=10,crystal=calcite", "--ray",
+            "o=0,0,-1 d=0,0,1 lambda=589", (const char *)NULL);
+    expect_success(&p, "built-in crystal");
+    proc_free(&p);
+}
+
 int main(void)
 {
     double i2;
@@ -944,5 +990,6 @@ int main(void)
     test_catalog();
     test_help_version();
     test_errors();
+    test_crystal();
     return check_finish("test_lenstrace_cli");
 }

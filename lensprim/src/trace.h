@@ -37,6 +37,14 @@ lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_v
                    lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
                    uint64_t path, lp_error *err);
 
+/* Send one outgoing field (branch b, leaving the local point p) to the
+ * result, or count its power as skipped when args' flags or filter
+ * decline it. */
+struct lp__branch;
+lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
+                    const struct lp__branch *b, lp_vec3 p, const lp__payload *pl, int depth,
+                    lp_kind kind, int surface, uint64_t path, lp_error *err);
+
 /* Make v a unit vector perpendicular to the unit d; 0 if impossible. */
 int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out);
 

@@ -135,6 +135,9 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     bw->warnings = 0;
     if ((st = lp__args_resolve(args, &bw->args, err)) != LP_OK)
         return st;
+    if (lens->desc.uniaxial)
+        return lp__fail(err, LP_ERROR_UNSUPPORTED,
+                        "backward tracing through a uniaxial crystal is not implemented");
     if (!v3_finite(origin) || !v3_finite(dir))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "view ray is not finite");
     lp_vec3 dw = v3_normalize(dir);
