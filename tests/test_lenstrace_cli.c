@@ -885,8 +885,6 @@ static void test_errors(void)
         "--ray", Y);
     BAD("axis", "axis without a crystal", "--lens", "R1=0,R2=0,t=1,D=10,glass=N-BK7,axis=0:0:1",
         "--ray", Y);
-    BAD("crystal", "backward through a crystal", "--lens", "R1=0,R2=0,t=1,D=10,crystal=quartz",
-        "--ray", Y, "--backward");
     BAD("d", "zero direction", "--lens", L, "--ray", "o=0,0,-10 d=0,0,0");
     BAD(NULL, "impossible lens D=60 R1=25.8", "--lens",
         "R1=25.8,R2=inf,t=5.3,D=60,glass=N-BK7", "--ray", Y);
@@ -971,6 +969,21 @@ static void test_crystal(void)
     p = run("--lens", "R1=0,R2=0,t=0.03,D=10,crystal=calcite", "--ray",
             "o=0,0,-1 d=0,0,1 lambda=589", (const char *)NULL);
     expect_success(&p, "built-in crystal");
+    proc_free(&p);
+    /* backward: the same o and e rays reach the eye */
+    p = run("--lens", "R1=0,R2=0,t=0.03,D=10,no=1.6584,ne=1.4864,axis=1:1:0", "--ray",
+            "o=0,0,-1 d=0,0,1 lambda=587.7247 vp=1,0,0", "--depth", "2", "--backward",
+            (const char *)NULL);
+    expect_success(&p, "crystal backward");
+    parse_output(&p, &o, "crystal backward");
+    check_balance(&o, "crystal backward");
+    double sum2 = 0;
+    for (size_t i = 0; i < o.n; i++)
+        if (o.rays[i].depth == 2)
+            sum2 += o.rays[i].I;
+    double Ro = fresnel_normal(1.0, no), Re = fresnel_normal(1.0, ne);
+    CHECK_REL(sum2, 0.5 * ((1 - Ro) * (1 - Ro) + (1 - Re) * (1 - Re)), 1e-12,
+              "crystal backward: depth-2 power");
     proc_free(&p);
 }
 

@@ -243,8 +243,9 @@ LP_API const char *lp_catalog_name(const lp_catalog *catalog, size_t i);
 /* A uniaxial crystal: an ordinary index n_o(lambda) and an extraordinary
  * index n_e(lambda), each a glass (dispersion formula, and the
  * absorption of the wave with its field across / along the optic axis),
- * and the optic axis in the lens's local frame (any finite non-zero
- * vector; the lens normalizes it).  A wave whose normal makes the angle
+ * and the optic axis as a WORLD direction (any finite non-zero vector;
+ * the lens normalizes it; a lens at the origin along +z, as lenstrace
+ * has it, has its local frame equal to the world's).  A wave whose normal makes the angle
  * psi with the axis has two modes: the ordinary wave of index n_o, field
  * perpendicular to the plane (wave normal, axis), ray along the normal;
  * and the extraordinary wave of index n(psi), 1/n^2 = cos^2(psi)/n_o^2 +
@@ -267,7 +268,7 @@ LP_API void lp_crystal_init_constant(lp_crystal *crystal, double n_o, double n_e
                                      lp_vec3 axis);
 
 /* Copy the built-in crystal `name` (case-insensitive) into *out, its axis
- * set to +z (a c-cut plate of a lens along z).  Built in, lossless, room
+ * set to +z (a c-cut plate of a lens along +z).  Built in, lossless, room
  * temperature, o and e Sellmeier formulas (micrometres) as published and
  * taken as relative to air:
  *   "calcite"   CaCO3, Ghosh, Opt. Commun. 163, 95 (1999), 204-2172 nm
@@ -499,6 +500,7 @@ typedef struct lp_query {
                          the exact transmittance. */
     double weight;    /* unpolarized transmittance estimate: the fresnel
                          (or schlick) product along the path */
+    uint64_t waves;   /* crystal lenses: as lp_out_ray.waves; 0 for glass */
 } lp_query;
 
 typedef struct lp_backward lp_backward;
@@ -520,7 +522,8 @@ LP_API size_t lp_backward_query_count(const lp_backward *bw);
 LP_API const lp_query *lp_backward_queries(const lp_backward *bw);
 
 /* Depth at which the view ray's chain met the rim (1 = the view ray hit
- * the rim itself), or 0 if it did not (within max_depth). */
+ * the rim itself), or 0 if it did not (within max_depth).  Through a
+ * crystal, the smallest depth at which a branch of its tree did. */
 LP_API int lp_backward_rim_depth(const lp_backward *bw);
 
 /* Phase 2, gather.  bundle[0..n) are linearly polarized rays arriving

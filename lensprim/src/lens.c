@@ -153,6 +153,8 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
     lens->desc.axis = lens->w;
     lens->u = v3_any_perp(lens->w);
     lens->v = v3_cross(lens->w, lens->u);
+    if (desc->uniaxial)
+        lens->crystal_axis = lp__to_local_dir(lens, lens->desc.crystal.axis);
     *out = lens;
     lp__ok(err);
     return LP_OK;

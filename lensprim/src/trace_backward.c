@@ -16,6 +16,7 @@
 #include "error.h"
 #include "interface.h"
 #include "trace.h"
+#include "trace_crystal.h"
 
 typedef struct bw_node {
     lp_vec3 p;       /* local point */
@@ -37,6 +38,7 @@ struct lp_backward {
     lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
     int rim_depth;
     unsigned warnings;
+    lp__xback *xb;                 /* the last build's, through a crystal */
 };
 
 lp_status lp_backward_create(lp_backward **out, lp_error *err)
@@ -52,21 +54,29 @@ lp_status lp_backward_create(lp_backward **out, lp_error *err)
 
 void lp_backward_destroy(lp_backward *bw)
 {
+    if (bw)
+        lp__xback_free(bw->xb);
     free(bw);
 }
 
 size_t lp_backward_query_count(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_query_count(bw->xb);
     return bw ? bw->n_queries : 0;
 }
 
 const lp_query *lp_backward_queries(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_queries(bw->xb);
     return bw ? bw->query : NULL;
 }
 
 int lp_backward_rim_depth(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_rim_depth(bw->xb);
     return bw ? bw->rim_depth : 0;
 }
 
@@ -105,6 +115,7 @@ static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_
     q->op = op;
     q->bound = bound;
     q->weight = weight;
+    q->waves = 0;
     if (bound < bw->args.min_weight)
         return;
     info.depth = depth;
@@ -135,9 +146,7 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     bw->warnings = 0;
     if ((st = lp__args_resolve(args, &bw->args, err)) != LP_OK)
         return st;
-    if (lens->desc.uniaxial)
-        return lp__fail(err, LP_ERROR_UNSUPPORTED,
-                        "backward tracing through a uniaxial crystal is not implemented");
+    lp__xback_deactivate(bw->xb);
     if (!v3_finite(origin) || !v3_finite(dir))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "view ray is not finite");
     lp_vec3 dw = v3_normalize(dir);
@@ -160,6 +169,8 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
         lp__ok(err);
         return LP_OK;
     }
+    if (lens->desc.uniaxial)
+        return lp__crystal_build(&bw->xb, lens, &bw->optics, &bw->args, d, &h, err);
 
     int entry = h.surface;
     bw->n_nodes = 1;
@@ -296,6 +307,8 @@ lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bund
     lp_status st;
     if (!bw || !out || (!bundle && n > 0))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_gather: NULL argument");
+    if (lp__xback_active(bw->xb))
+        return lp__crystal_gather(bw->xb, q, bundle, n, out, err);
     if (q >= bw->n_queries)
         return lp__fail(err, LP_ERROR_RANGE, "query %zu does not exist (%zu queries)", q,
                         bw->n_queries);

@@ -40,7 +40,7 @@ lp_status lp__crystal_optics_at(const lp_lens *lens, lp__optics *o, lp__crystal_
     if (!isfinite(ne) || !(ne > 0.0))
         return lp__fail(err, LP_ERROR_INVALID_GLASS, "crystal %s has no valid n_e at %g nm",
                         c->name, o->lambda_nm);
-    x->crystal = (lp__medium){1, o->n_glass, ne, c->axis};
+    x->crystal = (lp__medium){1, o->n_glass, ne, lens->crystal_axis};
     x->medium = (lp__medium){0, o->n_medium, o->n_medium, v3(0, 0, 1)};
     x->alpha_o = o->alpha;
     x->alpha_e = lp_glass_absorption(&c->extraordinary, o->lambda_nm);

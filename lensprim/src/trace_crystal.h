@@ -28,4 +28,26 @@ lp_status lp__crystal_forward(const lp_lens *lens, lp__optics *o, const lp_trace
                               const lp__local_hit *h, lp_vec3 d, const lp__cvec3 *E,
                               const lp__payload *pl, lp_result *res, lp_error *err);
 
+/* Backward tracing through a crystal: the state an lp_backward keeps
+ * for it (trace_crystal_backward.c). */
+typedef struct lp__xback lp__xback;
+
+void lp__xback_free(lp__xback *x);
+/* 1 when the last build was through a crystal (x may be NULL). */
+int lp__xback_active(const lp__xback *x);
+void lp__xback_deactivate(lp__xback *x);
+size_t lp__xback_query_count(const lp__xback *x);
+const lp_query *lp__xback_queries(const lp__xback *x);
+int lp__xback_rim_depth(const lp__xback *x);
+
+/* Build the view ray's tree after its entry hit h (not the rim), local
+ * unit direction d; *xp is created on first use.  args are resolved. */
+lp_status lp__crystal_build(lp__xback **xp, const lp_lens *lens, const lp__optics *optics,
+                            const lp_trace_args *args, lp_vec3 d, const lp__local_hit *h,
+                            lp_error *err);
+
+/* Gather as lp_backward_gather. */
+lp_status lp__crystal_gather(const lp__xback *x, size_t q, const lp_ray *bundle, size_t n,
+                             lp_result *out, lp_error *err);
+
 #endif
