@@ -81,7 +81,24 @@ struct rs_worker {
     bundle pixel;
     lp_vec3 ref;     /* the pixel's phase reference point (see plane_op) */
     lp_vec3 ref_dir; /* and the direction of its camera ray */
+    uint64_t splits; /* crystal lens hits, for RS_CH_SPLIT tags */
 };
+
+/* Rays a crystal lens split into o and e rays.  The rays one lens hit
+ * returns on queries of one depth and kind, grown from one source's one
+ * half, come from one point of that source (their paths are joined to a
+ * common source point, as for any pair of beams meeting at a pixel), so
+ * they are mutually coherent whatever the source's `coherent` setting:
+ * their ch gets RS_CH_SPLIT, the depth and kind, and a number unique to
+ * the lens hit in bits 40-62; bits 0-31 keep 2 source + half. */
+#define RS_CH_SPLIT ((uint64_t)1 << 63)
+#define RS_CH_SOURCE 0xffffffffull
+
+static uint64_t split_tag(uint64_t hit, const lp_query *q)
+{
+    return RS_CH_SPLIT | (hit & 0x7fffff) << 40 | (uint64_t)(q->kind != 0) << 39 |
+           (uint64_t)(q->depth & 0x7f) << 32;
+}
 
 /* Source ids: 0 ambient, 1 background, 2 + k light k, 2 + L + i object i. */
 static int src_light(const rs_integrator *it, int k) { (void)it; return 2 + k; }
@@ -628,6 +645,7 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
             return;
         size_t nq = lp_backward_query_count(fr->bw);
         const lp_query *q = lp_backward_queries(fr->bw);
+        uint64_t hit = ++w->splits;
         for (size_t k = 0; k < nq; k++) {
             fr->child.n = 0;
             trace_pol(w, b, q[k].origin, q[k].dir, level + q[k].depth, weight * q[k].bound, -1,
@@ -637,11 +655,14 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
             lp_result_clear(&fr->res);
             if (lp_backward_gather(fr->bw, k, fr->child.r, fr->child.n, &fr->res, NULL) != LP_OK)
                 continue;
+            uint64_t tag = ob->u.lens.desc.uniaxial ? split_tag(hit, &q[k]) : 0;
             for (size_t i = 0; i < fr->res.count; i++) {
                 lp_ray *r = bundle_push(out);
                 if (!r)
                     return;
                 *r = fr->res.rays[i].ray;
+                if (tag)
+                    r->ch = (r->ch & RS_CH_SOURCE) | tag;
             }
         }
         shift_op(out, start, h.t);
@@ -688,10 +709,12 @@ static double bundle_power(const rs_integrator *it, const bundle *bd, double lam
     for (size_t i = 0; i < bd->n; i++) {
         const lp_ray *a = &bd->r[i];
         total += a->intensity;
-        uint64_t src = a->ch / 2;
-        if (src >= (uint64_t)it->n_sources || !it->coherent[src] || a->intensity == 0.0)
+        uint64_t src = (a->ch & RS_CH_SOURCE) / 2;
+        int split = (a->ch & RS_CH_SPLIT) != 0;
+        if (src >= (uint64_t)it->n_sources || !(it->coherent[src] || split) ||
+            a->intensity == 0.0)
             continue;
-        double lc = it->coherence[src];
+        double lc = it->coherent[src] ? it->coherence[src] : 0.0;
         double pa = k0 * a->op - RS_PI * a->kphi + a->phase;
         for (size_t j = i + 1; j < bd->n; j++) {
             const lp_ray *b = &bd->r[j];
