@@ -1066,6 +1066,7 @@ static void test_crystal(void)
         seen_o += !e;
     }
     CHECK(seen_o == 1 && seen_e == 1, "crystal: one o and one e ray (%d, %d)", seen_o, seen_e);
+    free(o.buf);
     proc_free(&p);
     p = run("--lens", "R1=0,R2=0,t=0.03,D=10,crystal=calcite", "--ray",
             "o=0,0,-1 d=0,0,1 lambda=589", (const char *)NULL);
@@ -1085,6 +1086,7 @@ static void test_crystal(void)
     double Ro = fresnel_normal(1.0, no), Re = fresnel_normal(1.0, ne);
     CHECK_REL(sum2, 0.5 * ((1 - Ro) * (1 - Ro) + (1 - Re) * (1 - Re)), 1e-12,
               "crystal backward: depth-2 power");
+    free(o.buf);
     proc_free(&p);
 }
 
