@@ -249,14 +249,9 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, l
     lp_vec3 vp;
     int k = q->depth;
 
-    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
-        !isfinite(b->phase))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
-    if (!v3_finite(b->vp) ||
-        !lp__perp_unit(lp__to_local_dir(bw->lens, b->vp), light, &vp))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray polarization must be finite and not parallel to the query ray");
+    lp_status st0 = lp__bundle_ray_check(bw->lens, b, light, &vp, err);
+    if (st0 != LP_OK)
+        return st0;
 
     double I0 = b->intensity;
     lp__cvec3 E = cv3_real(vp, sqrt(I0));
@@ -291,14 +286,8 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, l
         }
     }
     res->nodes += (size_t)k;
-    double before = res->out;
-    lp_status st = lp__emit(bw->lens, res, &E, bw->node[1].p, v3_neg(bw->view_dir), &pl, k,
-                            q->kind, q->surface, q->path, err);
-    if (st != LP_OK)
-        return st;
-    res->absorbed_glass += absorbed;
-    res->truncated += I0 - (res->out - before) - absorbed;
-    return LP_OK;
+    return lp__emit_gathered(bw->lens, res, &E, bw->node[1].p, v3_neg(bw->view_dir), &pl, q,
+                             I0, absorbed, err);
 }
 
 lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,

@@ -139,3 +139,32 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
     }
     return lp__emit(lens, res, &b->E, p, b->dir, pl, depth, kind, surface, path, err);
 }
+
+lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,
+                               lp_vec3 *vp, lp_error *err)
+{
+    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
+        !isfinite(b->phase))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
+    if (!v3_finite(b->vp) || !lp__perp_unit(lp__to_local_dir(lens, b->vp), light, vp))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "bundle ray polarization must be finite and not parallel to the query ray");
+    return LP_OK;
+}
+
+lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
+                            lp_vec3 d, const lp__payload *pl, const lp_query *q, double in,
+                            double absorbed, lp_error *err)
+{
+    double before = res->out;
+    size_t first = res->count;
+    lp_status st = lp__emit(lens, res, E, p, d, pl, q->depth, q->kind, q->surface, q->path, err);
+    if (st != LP_OK)
+        return st;
+    for (size_t i = first; i < res->count; i++)
+        res->rays[i].waves = q->waves;
+    res->absorbed_glass += absorbed;
+    res->truncated += in - (res->out - before) - absorbed;
+    return LP_OK;
+}

@@ -297,13 +297,9 @@ static lp_status gather_one(const lp__xback *x, size_t qi, const lp_ray *b, lp_r
     lp__xnode nd;
     lp__cvec3 out[4];
 
-    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
-        !isfinite(b->phase))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
-    if (!v3_finite(b->vp) || !lp__perp_unit(lp__to_local_dir(x->lens, b->vp), light, &vp))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray polarization must be finite and not parallel to the query ray");
+    lp_status st = lp__bundle_ray_check(x->lens, b, light, &vp, err);
+    if (st != LP_OK)
+        return st;
     double I0 = b->intensity, absorbed = 0.0;
     lp__cvec3 E = cv3_real(vp, sqrt(I0));
     lp__payload pl = {x->optics.lambda_nm, b->kphi, b->op + q->op, b->phase, b->ch};
@@ -353,17 +349,8 @@ static lp_status gather_one(const lp__xback *x, size_t qi, const lp_ray *b, lp_r
         res->absorbed_glass += absorbed;
         return LP_OK;
     }
-    double before = res->out;
-    size_t first = res->count;
-    lp_status st = lp__emit(x->lens, res, &E, x->node[0].p, v3_neg(x->view_dir), &pl, q->depth,
-                            q->kind, q->surface, q->path, err);
-    if (st != LP_OK)
-        return st;
-    for (size_t i = first; i < res->count; i++)
-        res->rays[i].waves = q->waves;
-    res->absorbed_glass += absorbed;
-    res->truncated += I0 - (res->out - before) - absorbed;
-    return LP_OK;
+    return lp__emit_gathered(x->lens, res, &E, x->node[0].p, v3_neg(x->view_dir), &pl, q, I0,
+                             absorbed, err);
 }
 
 lp_status lp__crystal_gather(const lp__xback *x, size_t q, const lp_ray *bundle, size_t n,
