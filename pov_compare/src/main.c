@@ -23,14 +23,14 @@
 
 #include "camera.h"
 #include "compare.h"
-#include "image.h"
+#include "support/image.h"
 #include "integrator.h"
 #include "montage.h"
 #include "parser.h"
 #include "povray.h"
 #include "report.h"
 #include "scene.h"
-#include "tiles.h"
+#include "support/tiles.h"
 #include "translate.h"
 
 #define EXIT_RENDER 1

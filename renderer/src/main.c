@@ -13,11 +13,11 @@
 
 #include "args.h"
 #include "camera.h"
-#include "image.h"
+#include "support/image.h"
 #include "integrator.h"
 #include "parser.h"
 #include "scene.h"
-#include "tiles.h"
+#include "support/tiles.h"
 
 #define EXIT_RENDER 1
 #define EXIT_BAD 2

@@ -52,7 +52,7 @@
 
 #include "camera.h"
 #include "check.h"
-#include "image.h"
+#include "support/image.h"
 #include "parser.h"
 #include "scene.h"
 #include "translate.h"
