@@ -39,7 +39,8 @@
 #include "integrator.h"
 #include "parser.h"
 #include "scene.h"
-#include "spectrum.h"
+#include "emitter.h"
+#include "support/colorimetry.h"
 
 #define PI 3.14159265358979323846
 
