@@ -46,7 +46,9 @@ rs_worker *rs_worker_create(const rs_integrator *it);
 void rs_worker_destroy(rs_worker *w);
 
 /* Linear sRGB of pixel (i, j), i = column from the left, j = row from the
- * top.  Deterministic for a given scene, options and pixel. */
+ * top: what its camera ray brings, or with a camera aperture the mean of
+ * its aperture rays (camera.h).  Deterministic for a given scene, options
+ * and pixel. */
 void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j,
                          rs_color *out);
 

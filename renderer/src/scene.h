@@ -123,6 +123,10 @@ typedef struct rs_camera {
     int has_angle;
     rs_transform xf;        /* transforms applied to the camera */
     int has_xf;
+    lp_vec3 focal_point;    /* default <0,0,0>: the point in focus */
+    double aperture;        /* default 0: a pinhole; else the diameter of
+                               the lens disk (camera.h) */
+    int blur_samples;       /* aperture rays per pixel; 0: the default */
 } rs_camera;
 
 typedef struct rs_settings {
