@@ -9,26 +9,21 @@
  * Refraction is reversible, so the light path is the eye path reversed;
  * at each node G is applied in the direction of light: at node k the
  * light refracts in (or, k = 1, reflects off the outside), at nodes
- * k-1..2 it reflects inside, at node 1 it refracts out.  In the polarized
- * mode the nodes of the light's way are set up once, at build: every
- * bundle ray of every query runs through the same ones.  (The unpolarized
- * modes mostly use the queries' weights and gather little.) */
+ * k-1..2 it reflects inside, at node 1 it refracts out. */
 #include <math.h>
 #include <stdlib.h>
 
 #include "error.h"
 #include "interface.h"
 #include "trace.h"
+#include "trace_crystal.h"
 
 typedef struct bw_node {
     lp_vec3 p;       /* local point */
     lp_vec3 n;       /* outward normal */
     lp_vec3 e_out;   /* eye direction inside the glass leaving this node */
     double seg;      /* length from this node to the next one */
-    double seg_att;  /* amplitude factor over seg: exp(-alpha seg / 2) */
-    double seg_abs;  /* power fraction absorbed over seg: 1 - seg_att^2 */
     int surface;
-    lp__node light;  /* light arriving from inside along -e_out */
 } bw_node;
 
 struct lp_backward {
@@ -41,11 +36,9 @@ struct lp_backward {
     size_t n_queries;
     lp_query query[LP_MAX_DEPTH];
     lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
-    lp__node query_node[LP_MAX_DEPTH]; /* light arriving along -query_dir */
-    lp__exit exit;                   /* where gathered light leaves */
-    int nodes_ready;                 /* node[].light and query_node[] are set */
     int rim_depth;
     unsigned warnings;
+    lp__xback *xb;                 /* the last build's, through a crystal */
 };
 
 lp_status lp_backward_create(lp_backward **out, lp_error *err)
@@ -61,21 +54,29 @@ lp_status lp_backward_create(lp_backward **out, lp_error *err)
 
 void lp_backward_destroy(lp_backward *bw)
 {
+    if (bw)
+        lp__xback_free(bw->xb);
     free(bw);
 }
 
 size_t lp_backward_query_count(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_query_count(bw->xb);
     return bw ? bw->n_queries : 0;
 }
 
 const lp_query *lp_backward_queries(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_queries(bw->xb);
     return bw ? bw->query : NULL;
 }
 
 int lp_backward_rim_depth(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_rim_depth(bw->xb);
     return bw ? bw->rim_depth : 0;
 }
 
@@ -88,29 +89,14 @@ static double node_bound(const lp__node *nd, lp_mode mode, int reflect)
         return reflect ? R : 1.0 - R;
     }
     if (reflect)
-        return lp__max(nd->f.Rs, nd->f.Rp);
-    return lp__max(nd->f.ts * nd->f.ts, nd->f.tp * nd->f.tp);
+        return fmax(nd->f.Rs, nd->f.Rp);
+    return fmax(nd->f.ts * nd->f.ts, nd->f.tp * nd->f.tp);
 }
 
 static double node_weight(const lp__node *nd, lp_mode mode, int reflect)
 {
     double R = lp__node_reflectance(nd, mode == LP_MODE_POLARIZED ? LP_MODE_FRESNEL : mode);
     return reflect ? R : 1.0 - R;
-}
-
-/* The node where light answering query qi enters the lens (any field). */
-static void query_node(const lp_backward *bw, size_t qi, lp__node *nd)
-{
-    const lp_query *q = &bw->query[qi];
-    lp__node_setup(nd, v3_neg(bw->query_dir[qi]), bw->node[q->depth].n, bw->optics.n_medium,
-                   bw->optics.n_glass, NULL);
-}
-
-/* The node j of the way back, light arriving from inside (any field). */
-static void light_node(const lp_backward *bw, int j, lp__node *nd)
-{
-    lp__node_setup(nd, v3_neg(bw->node[j].e_out), bw->node[j].n, bw->optics.n_glass,
-                   bw->optics.n_medium, NULL);
 }
 
 static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
@@ -129,6 +115,7 @@ static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_
     q->op = op;
     q->bound = bound;
     q->weight = weight;
+    q->waves = 0;
     if (bound < bw->args.min_weight)
         return;
     info.depth = depth;
@@ -140,8 +127,6 @@ static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_
     if (!lp__args_keep(&bw->args, &info))
         return;
     bw->query_dir[bw->n_queries] = dir;
-    if (bw->nodes_ready)
-        query_node(bw, bw->n_queries, &bw->query_node[bw->n_queries]);
     bw->n_queries++;
 }
 
@@ -159,9 +144,9 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     bw->n_queries = 0;
     bw->rim_depth = 0;
     bw->warnings = 0;
-    bw->nodes_ready = 0;
     if ((st = lp__args_resolve(args, &bw->args, err)) != LP_OK)
         return st;
+    lp__xback_deactivate(bw->xb);
     if (!v3_finite(origin) || !v3_finite(dir))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "view ray is not finite");
     lp_vec3 dw = v3_normalize(dir);
@@ -170,14 +155,11 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     if ((st = lp__optics_at(lens, lambda_nm, &bw->optics, err)) != LP_OK)
         return st;
     bw->warnings = bw->optics.warnings;
-    bw->nodes_ready = bw->args.mode == LP_MODE_POLARIZED;
 
     const lp__optics *o = &bw->optics;
     lp_mode mode = bw->args.mode;
     lp_vec3 p = lp__to_local_point(lens, origin), d = lp__to_local_dir(lens, dw);
     bw->view_dir = d;
-    bw->exit.d = v3_neg(d);
-    bw->exit.world_dir = v3_neg(dw);
     if (!lp__lens_hit(lens, p, d, lp__lens_surface_at(lens, p), 0.0, INFINITY, &h)) {
         lp__ok(err);
         return LP_OK;
@@ -187,9 +169,10 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
         lp__ok(err);
         return LP_OK;
     }
+    if (lens->desc.uniaxial)
+        return lp__crystal_build(&bw->xb, lens, &bw->optics, &bw->args, d, &h, err);
 
     int entry = h.surface;
-    bw->exit.world_origin = lp__to_world_point(lens, h.p);
     bw->n_nodes = 1;
     bw->node[1].p = h.p;
     bw->node[1].n = h.n;
@@ -213,22 +196,17 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     p = h.p;
     int surface = h.surface;
     bw->node[1].e_out = d;
-    if (bw->nodes_ready)
-        light_node(bw, 1, &bw->node[1].light);
 
     while (depth < bw->args.max_depth && !(bound < bw->args.min_weight)) {
         if (!lp__lens_hit(lens, p, d, surface, 0.0, INFINITY, &h)) {
             bw->warnings |= LP_WARN_LEAK;
             break;
         }
-        double m = o->alpha > 0.0 ? expm1(-0.5 * o->alpha * h.t) : 0.0;
-        double att = (1.0 + m) * (1.0 + m);
+        double att = o->alpha > 0.0 ? exp(-o->alpha * h.t) : 1.0;
         bound *= att;
         weight *= att;
         op += o->n_glass * h.t;
         bw->node[depth].seg = h.t;
-        bw->node[depth].seg_att = 1.0 + m;
-        bw->node[depth].seg_abs = -m * (2.0 + m);
         if (h.surface == LP_SURFACE_RIM) {
             bw->rim_depth = depth + 1;
             break;
@@ -253,8 +231,6 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
         p = h.p;
         surface = h.surface;
         bw->node[depth].e_out = d;
-        if (bw->nodes_ready)
-            light_node(bw, depth, &bw->node[depth].light);
     }
     lp__ok(err);
     return LP_OK;
@@ -269,21 +245,13 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, l
     lp_mode mode = bw->args.mode;
     lp__node nd;
     lp__branch br;
+    lp_vec3 light = v3_neg(bw->query_dir[qi]); /* local, arriving at node k */
     lp_vec3 vp;
     int k = q->depth;
 
-    if (bw->nodes_ready)
-        nd = bw->query_node[qi];
-    else
-        query_node(bw, qi, &nd);
-    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
-        !isfinite(b->phase))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
-    if (!v3_finite(b->vp) ||
-        !lp__perp_unit(lp__to_local_dir(bw->lens, b->vp), nd.d, &vp))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray polarization must be finite and not parallel to the query ray");
+    lp_status st0 = lp__bundle_ray_check(bw->lens, b, light, &vp, err);
+    if (st0 != LP_OK)
+        return st0;
 
     double I0 = b->intensity;
     lp__cvec3 E = cv3_real(vp, sqrt(I0));
@@ -291,43 +259,35 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, l
     double absorbed = 0.0;
     res->in += I0;
 
-    /* Node k: the light reflects off the outside (k = 1) or refracts in. */
-    lp__node_refit(&nd, &E);
     if (k == 1) {
+        lp__node_setup(&nd, light, bw->node[1].n, o->n_medium, o->n_glass, &E);
         lp__node_reflect(&nd, mode, &E, &br);
+        E = br.E;
         pl.kphi += br.flip;
     } else {
+        lp__node_setup(&nd, light, bw->node[k].n, o->n_medium, o->n_glass, &E);
         lp__node_transmit(&nd, mode, &E, &br);
-    }
-    E = br.E;
-    /* Nodes k-1..2 reflect it inside; node 1 refracts it out. */
-    for (int j = k - 1; j >= 1; j--) {
-        if (o->alpha > 0.0) {
-            absorbed += cv3_norm2(E) * bw->node[j].seg_abs;
-            E = cv3_scale_real(E, bw->node[j].seg_att);
-        }
-        if (bw->nodes_ready)
-            nd = bw->node[j].light;
-        else
-            light_node(bw, j, &nd);
-        lp__node_refit(&nd, &E);
-        if (j > 1) {
-            lp__node_reflect(&nd, mode, &E, &br);
-            pl.kphi += br.flip;
-        } else {
-            lp__node_transmit(&nd, mode, &E, &br);
-        }
         E = br.E;
+        for (int j = k - 1; j >= 1; j--) {
+            double s = bw->node[j].seg;
+            if (o->alpha > 0.0) {
+                absorbed += cv3_norm2(E) * -expm1(-o->alpha * s);
+                E = cv3_scale(E, exp(-0.5 * o->alpha * s));
+            }
+            lp_vec3 dj = v3_neg(bw->node[j].e_out);
+            lp__node_setup(&nd, dj, bw->node[j].n, o->n_glass, o->n_medium, &E);
+            if (j > 1) {
+                lp__node_reflect(&nd, mode, &E, &br);
+                pl.kphi += br.flip;
+            } else {
+                lp__node_transmit(&nd, mode, &E, &br);
+            }
+            E = br.E;
+        }
     }
     res->nodes += (size_t)k;
-    double before = res->out;
-    lp_status st = lp__emit(bw->lens, res, &E, &bw->exit, &pl, k, q->kind, q->surface, q->path,
-                            err);
-    if (st != LP_OK)
-        return st;
-    res->absorbed_glass += absorbed;
-    res->truncated += I0 - (res->out - before) - absorbed;
-    return LP_OK;
+    return lp__emit_gathered(bw->lens, res, &E, bw->node[1].p, v3_neg(bw->view_dir), &pl, q,
+                             I0, absorbed, err);
 }
 
 lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
@@ -336,6 +296,8 @@ lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bund
     lp_status st;
     if (!bw || !out || (!bundle && n > 0))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_gather: NULL argument");
+    if (lp__xback_active(bw->xb))
+        return lp__crystal_gather(bw->xb, q, bundle, n, out, err);
     if (q >= bw->n_queries)
         return lp__fail(err, LP_ERROR_RANGE, "query %zu does not exist (%zu queries)", q,
                         bw->n_queries);

@@ -29,11 +29,6 @@ static inline int v3_finite(lp_vec3 a) { return isfinite(a.x) && isfinite(a.y) &
 /* Unit vector along a; a zero or non-finite a gives (0,0,0). */
 static inline lp_vec3 v3_normalize(lp_vec3 a)
 {
-    double l2 = v3_dot(a, a);
-    /* The common case: the squared length neither underflows nor
-     * overflows, and one square root and one division do. */
-    if (l2 > 1e-280 && l2 < 1e280)
-        return v3_scale(a, 1.0 / sqrt(l2));
     /* Scale by the largest component first: exact for tiny (denormal) and
      * huge vectors, whose squared length would underflow or overflow. */
     double m = fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
@@ -42,10 +37,6 @@ static inline lp_vec3 v3_normalize(lp_vec3 a)
     a = v3(a.x / m, a.y / m, a.z / m); /* not * (1/m): 1/m can overflow */
     return v3_scale(a, 1.0 / v3_len(a));
 }
-/* The larger and the smaller of two numbers that are not NaN (inline,
- * unlike fmax/fmin, which must handle NaN). */
-static inline double lp__max(double a, double b) { return a > b ? a : b; }
-static inline double lp__min(double a, double b) { return a < b ? a : b; }
 /* Any unit vector perpendicular to the unit vector a (deterministic). */
 static inline lp_vec3 v3_any_perp(lp_vec3 a)
 {
