@@ -58,6 +58,8 @@ int rs_lane_classes_create(const rs_scene *scene, const double *lambda, int n_la
                 continue;
             lp_lens_desc d;
             lp_lens_get_desc(o->lens, &d);
+            if (d.uniaxial)
+                continue; /* a crystal's o and e indices: no sharing */
             keys[k] = key_at(&d, lambda[k]);
             for (int j = 0; j < k; j++)
                 if (row[j] == j && same(&keys[j], &keys[k])) {
