@@ -327,6 +327,9 @@ static const char *type_name(rs_object_type t)
     case RS_OBJ_DISC: return "disc";
     case RS_OBJ_LENS: return "lens";
     case RS_OBJ_POLARIZER: return "polarizer";
+    case RS_OBJ_CYLINDER: return "cylinder";
+    case RS_OBJ_CONE: return "cone";
+    case RS_OBJ_TORUS: return "torus";
     }
     return "object";
 }

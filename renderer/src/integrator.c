@@ -95,6 +95,7 @@ void rs_render_opts_init(rs_render_opts *o)
     o->cutoff = -1.0;
     o->width = 320;
     o->height = 240;
+    o->aa = 1;
 }
 
 /* The linear sRGB colour of a light's spectrum (negative components of
@@ -665,10 +666,11 @@ static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
     return bundle_power(it, &w->pixel, b->lambda);
 }
 
-void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs_color *out)
+/* The colour seen along the camera ray through image point (px, py). */
+static void sample(const rs_integrator *it, rs_worker *w, double px, double py, rs_color *out)
 {
     lp_vec3 o, d;
-    rs_camera_ray(&it->view, i + 0.5, j + 0.5, it->opts.width, it->opts.height, &o, &d);
+    rs_camera_ray(&it->view, px, py, it->opts.width, it->opts.height, &o, &d);
 
     if (it->opts.mode == RS_MODE_RGB) {
         double v[3];
@@ -711,4 +713,25 @@ void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs
     out->r = M[0][0] * raw.r + M[0][1] * raw.g + M[0][2] * raw.b + rl.r;
     out->g = M[1][0] * raw.r + M[1][1] * raw.g + M[1][2] * raw.b + rl.g;
     out->b = M[2][0] * raw.r + M[2][1] * raw.g + M[2][2] * raw.b + rl.b;
+}
+
+void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs_color *out)
+{
+    int n = it->opts.aa > 1 ? it->opts.aa : 1;
+    rs_color sum = {0, 0, 0};
+    if (n == 1) {
+        sample(it, w, i + 0.5, j + 0.5, out);
+        return;
+    }
+    for (int b = 0; b < n; b++)
+        for (int a = 0; a < n; a++) {
+            rs_color c;
+            sample(it, w, i + (a + 0.5) / n, j + (b + 0.5) / n, &c);
+            sum.r += c.r;
+            sum.g += c.g;
+            sum.b += c.b;
+        }
+    out->r = sum.r / (n * n);
+    out->g = sum.g / (n * n);
+    out->b = sum.b / (n * n);
 }

@@ -72,6 +72,10 @@ typedef struct rs_parse_opts {
     int image_width;     /* the value of image_width; <= 0: 640 */
     int image_height;    /* the value of image_height; <= 0: 480 */
     size_t max_objects;  /* objects (and lights) allowed; 0: 100,000 */
+    /* Where #include looks after the including file's own directory, in
+     * order (POV-Ray's Library_Path); the caller owns the strings. */
+    const char *const *include_dirs;
+    size_t n_include_dirs;
 } rs_parse_opts;
 
 /* All zero: the defaults above. */

@@ -1,4 +1,5 @@
-/* shapes.c -- planes, spheres, boxes, discs, polarizers and lenses.
+/* shapes.c -- planes, spheres, boxes, discs, cylinders, cones, tori,
+ * polarizers and lenses (round_shapes.c has the cylinder, cone and torus).
  *
  * Plane, sphere, box and disc are intersected in object space: the world
  * ray is mapped by the inverse transform without renormalizing its
@@ -7,6 +8,7 @@
  * placement in their parameters. */
 #include <math.h>
 
+#include "round_shapes.h"
 #include "shapes.h"
 
 static double dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
@@ -163,6 +165,21 @@ int rs_object_intersect(const rs_object *ob, lp_vec3 origin, lp_vec3 dir, double
                       o, d, t_min, t_max, &t))
             return 0;
         n_obj = ob->u.disc.normal;
+        break;
+    case RS_OBJ_CYLINDER:
+        if (!rs_cone_hit(ob->u.cylinder.base, ob->u.cylinder.radius, ob->u.cylinder.cap,
+                         ob->u.cylinder.radius, ob->u.cylinder.open, o, d, t_min, t_max, &t,
+                         &n_obj))
+            return 0;
+        break;
+    case RS_OBJ_CONE:
+        if (!rs_cone_hit(ob->u.cone.base, ob->u.cone.base_radius, ob->u.cone.cap,
+                         ob->u.cone.cap_radius, ob->u.cone.open, o, d, t_min, t_max, &t, &n_obj))
+            return 0;
+        break;
+    case RS_OBJ_TORUS:
+        if (!rs_torus_hit(ob->u.torus.major, ob->u.torus.minor, o, d, t_min, t_max, &t, &n_obj))
+            return 0;
         break;
     default:
         return 0;

@@ -138,6 +138,19 @@ static int scene_ok(const rs_scene *s, char *why, size_t n)
                  unit(o->u.polarizer.axis) && isfinite(o->u.polarizer.radius) &&
                  o->u.polarizer.radius > 0.0;
             break;
+        case RS_OBJ_CYLINDER:
+            ok = fin(o->u.cylinder.base) && fin(o->u.cylinder.cap) &&
+                 o->u.cylinder.radius > 0.0 && isfinite(o->u.cylinder.radius);
+            break;
+        case RS_OBJ_CONE:
+            ok = fin(o->u.cone.base) && fin(o->u.cone.cap) && o->u.cone.base_radius >= 0.0 &&
+                 o->u.cone.cap_radius >= 0.0 && isfinite(o->u.cone.base_radius) &&
+                 isfinite(o->u.cone.cap_radius);
+            break;
+        case RS_OBJ_TORUS:
+            ok = o->u.torus.major > 0.0 && o->u.torus.minor > 0.0 &&
+                 isfinite(o->u.torus.major) && isfinite(o->u.torus.minor);
+            break;
         }
         if (!ok) {
             snprintf(why, n, "object %zu (line %d) has a non-finite, zero or non-unit value", i,
