@@ -468,6 +468,130 @@ LP_API lp_status lp_backward_gather(const lp_backward *bw, size_t q,
                                     const lp_ray *bundle, size_t n,
                                     lp_result *out, lp_error *err);
 
+/* ------------------------------------------------------------------ */
+/* The cone K of rim-free directions (the paper's section 5)           */
+/* ------------------------------------------------------------------ */
+
+/* The rim holds the mount: polarization cannot be followed past it, so an
+ * application that needs every ray of the tree asks which initial rays
+ * keep their whole internal chain off the rim.  The chain is the one
+ * lp_backward_build traces: the entry node (the initial ray meets a cap,
+ * not the rim) and the internal rays reflected from cap to cap, up to the
+ * node of depth max_depth.  Refraction is at args.lambda_nm; the chain
+ * follows the reflected ray after total internal reflection too.  An
+ * initial ray that misses the lens is not rim-free (it has no tree). */
+
+/* The frame points and directions are given and returned in. */
+typedef enum lp_frame {
+    LP_FRAME_LOCAL = 0, /* the lens's frame: axis +z, front vertex at 0 */
+    LP_FRAME_WORLD = 1
+} lp_frame;
+
+typedef struct lp_cone_args {
+    int max_depth;     /* dT, 1..LP_MAX_DEPTH; default 5 */
+    double lambda_nm;  /* wavelength in standard air; default 587.56 */
+    double tolerance;  /* width the bisection stops at: radians for a
+                          cone, millimetres for a beam; default 1e-9 */
+    int scan_steps;    /* grid steps over the bracket before bisecting,
+                          1..1000000; default 2048 */
+    lp_frame frame;    /* the frame of the arguments and results;
+                          default LP_FRAME_LOCAL */
+} lp_cone_args;
+
+/* Defaults as above. */
+LP_API void lp_cone_args_init(lp_cone_args *args);
+
+/* Is the initial ray origin + s*dir rim-free up to args->max_depth?  Sets
+ * *rim_free to 1 or 0.  A chain that loses its way numerically (see
+ * LP_WARN_LEAK) counts as not rim-free.  args NULL: defaults. */
+LP_API lp_status lp_rim_free(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir,
+                             const lp_cone_args *args, int *rim_free,
+                             lp_error *err);
+
+/* Where a cone's angles are measured from.  The axis is the unit vector
+ * from the apex to the front vertex; azimuth 0 is along `ref`, the part of
+ * the lens's local +x axis perpendicular to the axis (local +y when the
+ * axis lies along local x), and azimuth pi/2 along axis x ref.  The
+ * direction at polar angle theta and azimuth phi is
+ *     cos(theta) axis + sin(theta) (cos(phi) ref + sin(phi) axis x ref).
+ * For a beam (lp_beam_region) the same holds with the beam's direction
+ * as the axis and offsets instead of angles. */
+typedef struct lp_cone_frame {
+    lp_vec3 apex;  /* the point (a beam: the front vertex) */
+    lp_vec3 axis;  /* unit */
+    lp_vec3 ref;   /* unit, perpendicular to axis */
+} lp_cone_frame;
+
+/* The frame of the cone from `point` (in args->frame).  Refused: a point
+ * that is not finite, lies inside the glass, or is the front vertex. */
+LP_API lp_status lp_cone_frame_of(const lp_lens *lens, lp_vec3 point,
+                                  const lp_cone_args *args, lp_cone_frame *out,
+                                  lp_error *err);
+
+/* theta_K at one azimuth (radians): the largest polar angle such that every
+ * direction at a smaller angle on that azimuth is rim-free.  The bracket
+ * [0, the angle beyond which every ray misses the lens's bounding sphere]
+ * is scanned in args->scan_steps equal steps for the first direction that
+ * is not rim-free, and the step where it happens is bisected to
+ * args->tolerance; *theta is the rim-free end.  A rim-free interval
+ * narrower than one scan step that follows a gap narrower than one step
+ * can be missed (the grid is the resolution of "every direction").
+ * *theta is 0 when the axis itself is not rim-free. */
+LP_API lp_status lp_cone_theta(const lp_lens *lens, lp_vec3 point, double azimuth,
+                               const lp_cone_args *args, double *theta,
+                               lp_error *err);
+
+/* The cone as a whole. */
+typedef struct lp_cone {
+    lp_cone_frame frame;
+    int depth;           /* the dT it was computed for */
+    double solid_angle;  /* sr: the sum over the n azimuths of
+                            (1 - cos theta_K) * 2 pi / n (exact,
+                            2 pi (1 - cos theta_K), for a circular cone) */
+    double theta_min, theta_max; /* over the azimuths, radians */
+} lp_cone;
+
+/* theta_K at n >= 1 azimuths 2 pi k / n, k = 0..n-1, into theta[0..n), and
+ * the cone's summary into *out. */
+LP_API lp_status lp_cone_compute(const lp_lens *lens, lp_vec3 point,
+                                 const lp_cone_args *args, size_t n,
+                                 double *theta, lp_cone *out, lp_error *err);
+
+/* The collimated case: parallel light along `dir` (in args->frame).  The
+ * entry points are described in the plane perpendicular to dir by their
+ * offset from the ray through the front vertex: at azimuth phi (frame as
+ * above, the apex the front vertex) the largest offset rho_K such that
+ * every ray at a smaller offset on that azimuth is rim-free, found as
+ * theta_K is (mm). */
+typedef struct lp_beam_region {
+    lp_cone_frame frame;
+    int depth;
+    double area;         /* mm^2: the sum of rho_K^2 pi / n */
+    double radius_min, radius_max;
+} lp_beam_region;
+
+/* rho_K at n >= 1 azimuths 2 pi k / n into radius[0..n), the summary into
+ * *out.  Refused: a dir that is zero or not finite. */
+LP_API lp_status lp_beam_region_compute(const lp_lens *lens, lp_vec3 dir,
+                                        const lp_cone_args *args, size_t n,
+                                        double *radius, lp_beam_region *out,
+                                        lp_error *err);
+
+/* The paper's second experiment: the light a view ray gathers, by depth.
+ * Builds the view ray's queries (lp_backward_build with args; NULL: the
+ * defaults), answers every query with natural light of unit intensity --
+ * two mutually incoherent orthogonal linear halves of 1/2 -- and ADDS the
+ * intensity of the gathered bundle rays of depth k to by_depth[k], for
+ * k = 1..max_depth (by_depth has max_depth + 1 entries; [0] is not
+ * touched).  So the caller sums over many view rays, and by_depth[k] over
+ * the sum is the share of the outgoing intensity carried by depth k.
+ * args->flags select the queries: LP_SKIP_REFLECTED keeps the light from
+ * behind the lens only.  A view ray that misses the lens adds nothing. */
+LP_API lp_status lp_bundle_by_depth(const lp_lens *lens, lp_vec3 origin,
+                                    lp_vec3 dir, double lambda_nm,
+                                    const lp_trace_args *args,
+                                    double *by_depth, lp_error *err);
+
 #ifdef __cplusplus
 }
 #endif

@@ -23,6 +23,8 @@ static const char *const usage_text[] = {
 "usage: lenstrace --lens SPEC --ray SPEC [--depth N]\n"
 "                 [--mode polarized|fresnel|schlick] [--medium N]\n"
 "                 [--backward] [--catalog FILE.agf]...\n"
+"       lenstrace --lens SPEC --cone \"x,y,z\" [--depth N] [--azimuths K]\n"
+"                 [--lambda NM] [--medium N] [--catalog FILE.agf]...\n"
 "       lenstrace --help | --version\n"
 "\n"
 "Trace one ray through one lens and print every outgoing ray as JSON Lines.\n"
@@ -61,6 +63,11 @@ static const char *const usage_text[] = {
 "  --catalog FILE   load more glasses from a Zemax AGF file (repeatable;\n"
 "                   a later glass of the same name replaces an earlier one)\n"
 "  --backward       trace from the eye (see BACKWARD below)\n"
+"  --cone x,y,z     print the cone K of rim-free directions from that point\n"
+"                   (lens frame) at depth --depth instead of tracing a ray\n"
+"                   (see CONE below)\n"
+"  --azimuths K     with --cone: K azimuths evenly from 0 deg (default 36)\n"
+"  --lambda NM      with --cone: wavelength in standard air (default 587.56)\n"
 "  -h, --help       this text\n"
 "  -V, --version    the version\n"
 "\n",
@@ -103,6 +110,19 @@ static const char *const usage_text[] = {
 "  forward ray, with \"query_o\":[..],\"query_d\":[..] (the query ray it\n"
 "  came from) right after ch.  \"in\" in the summary is the total intensity\n"
 "  of the answers (I per query).\n"
+"\n"
+"CONE (--cone): a direction is rim-free when the initial ray from the point\n"
+"  meets a cap and its internal chain (the rays reflected from cap to cap)\n"
+"  meets no rim up to the node of depth --depth.  The cone's axis runs from\n"
+"  the point to the front vertex; azimuth 0 is along the part of +x\n"
+"  perpendicular to it (+y when the axis is along x).  One line per azimuth\n"
+"  phi = 360 k / K deg:\n"
+"  {\"azimuth\":phi,\"theta\":theta_K}  (degrees: every direction of that\n"
+"  azimuth closer to the axis than theta_K is rim-free; scan of 2048 steps\n"
+"  and bisection to 1e-9 rad), then\n"
+"  {\"cone\":{\"depth\":N,\"solid_angle\":sr,\"theta_min\":deg,\"theta_max\":deg,\n"
+"   \"lambda\":NM,\"axis\":[x,y,z],\"ref\":[x,y,z]}}\n"
+"  with solid_angle the sum of (1 - cos theta_K) 2 pi / K.\n"
 "\n"
 "EXIT STATUS: 0 on success; 2 on bad input or any error, with one line\n"
 "  \"lenstrace: <message>\" on stderr and nothing on stdout.  Warnings (a\n"
@@ -446,6 +466,54 @@ static int run_backward(run *r)
     return ok;
 }
 
+static double deg(double rad)
+{
+    return rad * (180.0 / 3.14159265358979323846);
+}
+
+static int run_cone(run *r)
+{
+    const lt_args *a = r->a;
+    size_t n = (size_t)a->azimuths;
+    double *theta = malloc(n * sizeof *theta);
+    lp_cone_args ca;
+    lp_cone cone;
+    lp_error err;
+    lp_status st;
+
+    if (!theta) {
+        snprintf(r->msg, sizeof r->msg, "out of memory");
+        return 0;
+    }
+    lp_cone_args_init(&ca);
+    ca.max_depth = a->depth;
+    ca.lambda_nm = a->lambda_nm;
+    memset(&err, 0, sizeof err);
+    st = lp_cone_compute(r->lens, a->cone_point, &ca, n, theta, &cone, &err);
+    if (st != LP_OK) {
+        snprintf(r->msg, sizeof r->msg, "--cone: %s", lib_message(&err, st));
+        free(theta);
+        return 0;
+    }
+    for (size_t k = 0; k < n; k++) {
+        char az[40];
+        fmt_num(az, sizeof az, 360.0 * (double)k / (double)n);
+        ob_printf(&r->out, "{\"azimuth\":%s", az);
+        ob_num(&r->out, "theta", deg(theta[k]));
+        ob_printf(&r->out, "}\n");
+    }
+    ob_printf(&r->out, "{\"cone\":{\"depth\":%d", cone.depth);
+    ob_num(&r->out, "solid_angle", cone.solid_angle);
+    ob_num(&r->out, "theta_min", deg(cone.theta_min));
+    ob_num(&r->out, "theta_max", deg(cone.theta_max));
+    ob_num(&r->out, "lambda", a->lambda_nm);
+    ob_vec(&r->out, "axis", cone.frame.axis);
+    ob_vec(&r->out, "ref", cone.frame.ref);
+    ob_printf(&r->out, "}}\n");
+    free(theta);
+    return 1;
+}
+
 /* Build the glass of the lens; 0 and r->msg on error. */
 static int make_glass(run *r, const lp_catalog *catalog, lp_glass *glass)
 {
@@ -541,9 +609,13 @@ static int build_and_trace(run *r)
     lp_trace_args_init(&r->targs);
     r->targs.mode = a->mode;
     r->targs.max_depth = a->depth;
-    ok = a->backward ? run_backward(r) : run_forward(r);
+    if (a->cone)
+        ok = run_cone(r);
+    else
+        ok = a->backward ? run_backward(r) : run_forward(r);
     if (ok) {
-        put_summary(&r->out, &r->sum);
+        if (!a->cone)
+            put_summary(&r->out, &r->sum);
         if (r->out.oom) {
             snprintf(r->msg, sizeof r->msg, "out of memory");
             ok = 0;
@@ -595,7 +667,7 @@ int main(int argc, char **argv)
      * standard air with air-relative indices (as glass catalogs do).  Trace
      * at the air wavelength and report the absolute optical path, so that
      * 2*pi*op/lambda stays exact with the vacuum lambda printed. */
-    r.n_air = lp_air_index(a->ray.lambda_nm);
+    r.n_air = a->cone ? 1.0 : lp_air_index(a->ray.lambda_nm); /* --cone: air */
     r.lambda_air = a->ray.lambda_nm / r.n_air;
     if (!isfinite(r.n_air)) {
         say(NULL, "lambda must be a vacuum wavelength of at least 160 nm");

@@ -134,22 +134,22 @@ static const char *parse_vec3(lt_args *args, const char *what, const char *s,
         char buf[LT_TOKEN_MAX];
         int r;
         if (k < 2 && !q)
-            return fail(args, "--ray: %s: expected x,y,z (no spaces inside "
+            return fail(args, "%s: expected x,y,z (no spaces inside "
                               "a value), got '%s'", what, s);
         if (k == 2 && q)
-            return fail(args, "--ray: %s: expected three components x,y,z, "
+            return fail(args, "%s: expected three components x,y,z, "
                               "got '%s'", what, s);
         if (!q)
             q = p + strlen(p);
         if (!copy_trimmed(p, q, buf, sizeof buf))
-            return fail(args, "--ray: %s: component %d is too long", what,
+            return fail(args, "%s: component %d is too long", what,
                         k + 1);
         r = parse_double(buf, &v[k]);
         if (r == 0)
-            return fail(args, "--ray: %s: component %d '%s' is not a number",
+            return fail(args, "%s: component %d '%s' is not a number",
                         what, k + 1, buf);
         if (r < 0 || !isfinite(v[k]))
-            return fail(args, "--ray: %s: component %d must be a finite "
+            return fail(args, "%s: component %d must be a finite "
                               "number, got '%s'", what, k + 1, buf);
         p = q + 1;
     }
@@ -397,11 +397,11 @@ const char *lt_parse_ray_spec(lt_args *args, const char *spec,
         seen[key] = 1;
         switch (key) {
         case RK_O:
-            if (parse_vec3(args, "o", val, &r.o))
+            if (parse_vec3(args, "--ray: o", val, &r.o))
                 return args->error;
             break;
         case RK_D:
-            if (parse_vec3(args, "d", val, &r.d))
+            if (parse_vec3(args, "--ray: d", val, &r.d))
                 return args->error;
             break;
         case RK_LAMBDA:
@@ -414,7 +414,7 @@ const char *lt_parse_ray_spec(lt_args *args, const char *spec,
                 r.unpolarized = 1;
             } else {
                 r.unpolarized = 0;
-                if (parse_vec3(args, "vp", val, &vp))
+                if (parse_vec3(args, "--ray: vp", val, &vp))
                     return args->error;
             }
             break;
@@ -464,11 +464,14 @@ void lt_args_init(lt_args *args)
     args->depth = 5;
     args->mode = LP_MODE_POLARIZED;
     args->medium = 1.0;
+    args->azimuths = 36;
+    args->lambda_nm = 587.56;
 }
 
 enum {
     OPT_LENS, OPT_RAY, OPT_DEPTH, OPT_MODE, OPT_MEDIUM, OPT_BACKWARD,
-    OPT_CATALOG, OPT_HELP, OPT_VERSION, OPT_COUNT
+    OPT_CATALOG, OPT_HELP, OPT_VERSION, OPT_CONE, OPT_AZIMUTHS, OPT_LAMBDA,
+    OPT_COUNT
 };
 
 static const struct {
@@ -478,6 +481,7 @@ static const struct {
     {"lens", 1},     {"ray", 1},      {"depth", 1},
     {"mode", 1},     {"medium", 1},   {"backward", 0},
     {"catalog", 1},  {"help", 0},     {"version", 0},
+    {"cone", 1},     {"azimuths", 1}, {"lambda", 1},
 };
 
 static const char *parse_depth(lt_args *args, const char *s)
@@ -611,13 +615,41 @@ const char *lt_args_parse(lt_args *args, int argc, char **argv)
         case OPT_BACKWARD:
             args->backward = 1;
             break;
+        case OPT_CONE:
+            if (parse_vec3(args, "--cone", value, &args->cone_point))
+                return args->error;
+            args->cone = 1;
+            break;
+        case OPT_AZIMUTHS: {
+            char *end;
+            long v;
+            errno = 0;
+            v = strtol(value, &end, 10);
+            if (*value == '\0' || is_space(*value) || *end != '\0' ||
+                errno == ERANGE || v < 1 || v > LT_AZIMUTHS_MAX)
+                return fail(args, "--azimuths must be an integer from 1 to %d, "
+                                  "got '%s'", LT_AZIMUTHS_MAX, value);
+            args->azimuths = (int)v;
+            break;
+        }
+        case OPT_LAMBDA:
+            if (parse_positive(args, "--lambda", "the wavelength", value,
+                               &args->lambda_nm))
+                return args->error;
+            break;
         }
     }
+    if (seen[OPT_CONE] && (seen[OPT_RAY] || seen[OPT_BACKWARD] || seen[OPT_MODE]))
+        return fail(args, "--cone traces no ray: it takes no --ray, --backward "
+                          "or --mode");
+    if (!seen[OPT_CONE] && (seen[OPT_AZIMUTHS] || seen[OPT_LAMBDA]))
+        return fail(args, "--%s needs --cone",
+                    seen[OPT_AZIMUTHS] ? "azimuths" : "lambda");
     if (!seen[OPT_LENS])
         return fail(args, "missing --lens (e.g. --lens "
                           "\"R1=25.8,R2=inf,t=5.3,D=25.4,glass=N-BK7\"; "
                           "try --help)");
-    if (!seen[OPT_RAY])
+    if (!seen[OPT_RAY] && !seen[OPT_CONE])
         return fail(args, "missing --ray (e.g. --ray \"o=0,3,-10 d=0,0,1 "
                           "vp=1,0,0\"; try --help)");
     args->error[0] = '\0';

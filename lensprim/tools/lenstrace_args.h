@@ -20,6 +20,7 @@
 #define LT_GLASS_NAME_MAX 128 /* longest accepted glass name + 1 */
 #define LT_CATALOG_MAX 16     /* --catalog may be given this many times */
 #define LT_ERROR_MAX 384
+#define LT_AZIMUTHS_MAX 100000 /* --azimuths at most */
 
 /* --lens "R1=..,R2=..,t=..,D=..,D2=..,glass=NAME|n=N" (or n=N as a key) */
 typedef struct lt_lens_spec {
@@ -52,6 +53,10 @@ typedef struct lt_args {
     lp_mode mode;         /* default LP_MODE_POLARIZED */
     double medium;        /* constant index, finite > 0, default 1 */
     int backward;
+    int cone;             /* --cone "x,y,z" given: print the cone K */
+    lp_vec3 cone_point;   /* its apex, in the lens's frame */
+    int azimuths;         /* --azimuths, 1..LT_AZIMUTHS_MAX, default 36 */
+    double lambda_nm;     /* --lambda (with --cone), in air, default 587.56 */
     const char *catalogs[LT_CATALOG_MAX]; /* point into argv */
     size_t n_catalogs;
     char error[LT_ERROR_MAX];
