@@ -192,6 +192,7 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
             return -1;
     }
 
+    v.orthographic = cam->orthographic;
     *out = v;
     return 0;
 }
@@ -201,6 +202,11 @@ void rs_camera_ray(const rs_view *v, double px, double py, int width,
 {
     double x0 = px / (double)width - 0.5;
     double y0 = 0.5 - py / (double)height;
+    if (v->orthographic) {
+        *origin = v_add(v_add(v->location, v_scale(v->R, x0)), v_scale(v->U, y0));
+        *dir = v_unit(v->D);
+        return;
+    }
     lp_vec3 d = v_add(v_add(v->D, v_scale(v->R, x0)), v_scale(v->U, y0));
     *origin = v->location;
     *dir = v_unit(d);

@@ -34,6 +34,8 @@
  * column i = 0..W-1 from the left, row j = 0..H-1 from the top, pixel
  * centre px = i + 0.5, py = j + 0.5,
  *   dir = normalize(D + (px/W - 0.5) R + (0.5 - py/H) U), origin = location.
+ * Orthographic (`orthographic`): dir = normalize(D) for every pixel,
+ *   origin = location + (px/W - 0.5) R + (0.5 - py/H) U.
  */
 #ifndef RS_CAMERA_H
 #define RS_CAMERA_H
@@ -50,6 +52,9 @@ typedef struct rs_view {
     lp_vec3 D;   /* direction: from location to the image centre */
     lp_vec3 R;   /* right: spans the image width, left edge to right edge */
     lp_vec3 U;   /* up: spans the image height, bottom edge to top edge */
+    int orthographic; /* rays along D from location + x0 R + y0 U (the
+                         image is |R| by |U| scene units), POV-Ray's
+                         orthographic camera */
 } rs_view;
 
 /* Build *out from the camera keywords *cam by the rules above.  width and

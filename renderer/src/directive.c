@@ -50,8 +50,7 @@ static int raw(parser *p, rs_token *t)
         return rs__error_at(p, t->line, t->column, "%s", f->lx.error);
     if (p->budget == 0)
         return rs__error_at(p, t->line, t->column,
-                            "the scene reads more than %llu tokens (an endless #while or "
-                            "macro recursion?)", (unsigned long long)RS_TOKEN_BUDGET);
+                            "the scene reads too many tokens (an endless #while?)");
     p->budget--;
     return 0;
 }
@@ -354,6 +353,10 @@ static int do_include(parser *p, const rs_token *d)
     if (name[0] == '\0') {
         free(name);
         return rs__error_at(p, at.line, at.column, "#include of an empty file name");
+    }
+    if (p->no_include) {
+        free(name);
+        return rs__error_at(p, d->line, d->column, "#include: include files are off here");
     }
     for (size_t k = 0; !found && k <= p->n_include_dirs; k++) {
         int n;

@@ -405,21 +405,47 @@ static int visible(const rs_scene *sc, lp_vec3 x, lp_vec3 to)
  * calls emit(source, radiance) for each non-zero source. */
 typedef void (*emit_fn)(void *ctx, int source, double radiance);
 
-static void shade(const rs_integrator *it, const band *b, const rs_hit *h, emit_fn emit, void *ctx)
+/* POV-Ray 3.7's highlights for one light (see rs_finish): phong about the
+ * mirror direction, specular (Blinn) about the half vector; the light's
+ * colour, not the pigment's. */
+static double highlight(const rs_finish *f, lp_vec3 n, lp_vec3 d, lp_vec3 l)
+{
+    double s = 0.0;
+    if (f->phong > 0.0) {
+        lp_vec3 r = madd(d, n, -2.0 * dot(d, n));
+        double c = dot(r, l);
+        if (c > 0.0)
+            s += f->phong * pow(c, f->phong_size);
+    }
+    if (f->specular > 0.0) {
+        lp_vec3 hv = unit((lp_vec3){l.x - d.x, l.y - d.y, l.z - d.z});
+        double c = dot(hv, n);
+        if (c > 0.0)
+            s += f->specular * pow(c, 1.0 / f->roughness);
+    }
+    return s;
+}
+
+/* Light leaving a surface towards the viewer along d, per source: emission,
+ * ambient, and for each visible light diffuse (N.L)^brilliance plus the
+ * highlights.  Calls emit(source, radiance) for each non-zero source. */
+static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_vec3 dir,
+                  emit_fn emit, void *ctx)
 {
     const rs_scene *sc = it->scene;
     const rs_object *o = &sc->objects[h->object];
+    const rs_finish *f = &o->finish;
     rs_color pig = pigment_at(&o->pigment, h->point);
-    double e = band_emission(b, mul(pig, o->finish.emission));
+    double e = band_emission(b, mul(pig, f->emission));
     if (e != 0.0)
         emit(ctx, src_object(it, h->object), e);
-    double a = band_emission(b, mul(pig, mul(o->finish.ambient, sc->settings.ambient_light)));
+    double a = band_emission(b, mul(pig, mul(f->ambient, sc->settings.ambient_light)));
     if (a != 0.0)
         emit(ctx, 0, a);
-    if (o->finish.diffuse == 0.0 || sc->n_lights == 0)
+    if (sc->n_lights == 0)
         return;
-    double rho = band_reflectance(b, pig) * o->finish.diffuse;
-    if (rho == 0.0)
+    double rho = band_reflectance(b, pig) * f->diffuse;
+    if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
         return;
     lp_vec3 x = madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
     for (size_t k = 0; k < sc->n_lights; k++) {
@@ -427,13 +453,46 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, emit_
         lp_vec3 ld = unit((lp_vec3){l->position.x - x.x, l->position.y - x.y,
                                     l->position.z - x.z});
         double c = dot(ld, h->normal);
-        if (c <= 0.0)
+        double s = highlight(f, h->normal, dir, ld);
+        double diff = c > 0.0 ? rho * (f->brilliance == 1.0 ? c : pow(c, f->brilliance)) : 0.0;
+        if (diff + s <= 0.0)
             continue;
         double p = band_light(it, b, (int)k);
         if (p == 0.0 || !visible(sc, x, l->position))
             continue;
-        emit(ctx, src_light(it, (int)k), rho * c * p);
+        emit(ctx, src_light(it, (int)k), (diff + s) * p);
     }
+}
+
+/* The mirror reflectivity of a surface in this band for a ray along d
+ * (0: none): `reflection` as min + (max - min) F, F the unpolarized Fresnel
+ * reflectance into the object's ior with fresnel on, else max. */
+static double reflectivity(const band *b, const rs_object *o, const rs_hit *h, lp_vec3 d)
+{
+    const rs_finish *f = &o->finish;
+    double rmax = band_reflectance(b, f->reflection_max);
+    if (!f->fresnel)
+        return rmax;
+    double rmin = band_reflectance(b, f->reflection_min);
+    double ci = -dot(d, h->normal), n = o->ior;
+    double F = 0.0;
+    if (ci > 1.0)
+        ci = 1.0;
+    double st2 = (1.0 - ci * ci) / (n * n);
+    if (st2 >= 1.0) {
+        F = 1.0;
+    } else if (n != 1.0) {
+        double ct = sqrt(1.0 - st2);
+        double rs = (ci - n * ct) / (ci + n * ct), rp = (n * ci - ct) / (n * ci + ct);
+        F = 0.5 * (rs * rs + rp * rp);
+    }
+    return rmin + (rmax - rmin) * F;
+}
+
+static int has_reflection(const rs_finish *f)
+{
+    const rs_color a = f->reflection_min, c = f->reflection_max;
+    return a.r > 0.0 || a.g > 0.0 || a.b > 0.0 || c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
 }
 
 /* ---- the unpolarized modes: one number per ray ---- */
@@ -488,7 +547,15 @@ static double trace_scalar(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, in
         return 0.5 * trace_scalar(w, b, h.point, d, level, 0.5 * weight, h.object, f + 1);
     }
     double sum = 0.0;
-    shade(it, b, &h, emit_sum, &sum);
+    shade(it, b, &h, d, emit_sum, &sum);
+    if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES) {
+        double r = reflectivity(b, ob, &h, d);
+        if (r > 0.0 && weight * r >= it->cutoff) {
+            lp_vec3 rd = unit(madd(d, h.normal, -2.0 * dot(d, h.normal)));
+            lp_vec3 x = madd(h.point, h.normal, 1e-9 * (1.0 + sqrt(dot(h.point, h.point))));
+            sum += r * trace_scalar(w, b, x, rd, level + 1, weight * r, -1, f + 1);
+        }
+    }
     return sum;
 }
 
@@ -537,6 +604,36 @@ static double plane_op(const rs_worker *w, lp_vec3 o, lp_vec3 d)
     (void)d;
     const lp_vec3 c = w->ref_dir;
     return c.x * (o.x - w->ref.x) + c.y * (o.y - w->ref.y) + c.z * (o.z - w->ref.z);
+}
+
+static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
+                      int skip, int f, bundle *out);
+
+/* A mirror reflection in the polarized mode: the bundle seen along the
+ * mirror direction, scaled by the reflectivity, each field mirrored
+ * (Householder) with a pi jump (an ideal conductor reverses the tangential
+ * field), its optical path referred to the origin of the ray along d. */
+static void mirror_pol(rs_worker *w, const band *b, const rs_object *ob, const rs_hit *h,
+                       lp_vec3 d, int level, double weight, int f, frame *fr, bundle *out)
+{
+    double r = reflectivity(b, ob, h, d);
+    if (!(r > 0.0) || weight * r < w->it->cutoff)
+        return;
+    lp_vec3 n = h->normal;
+    lp_vec3 rd = unit(madd(d, n, -2.0 * dot(d, n)));
+    lp_vec3 x = madd(h->point, n, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
+    fr->child.n = 0;
+    trace_pol(w, b, x, rd, level + 1, weight * r, -1, f + 1, &fr->child);
+    for (size_t i = 0; i < fr->child.n; i++) {
+        lp_ray *p = bundle_push(out);
+        if (!p)
+            return;
+        *p = fr->child.r[i];
+        p->intensity *= r;
+        p->vp = madd(p->vp, n, -2.0 * dot(p->vp, n));
+        p->kphi += 1;
+        p->op += h->t;
+    }
 }
 
 static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
@@ -616,7 +713,9 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
         return;
     }
     emit_ctx e = {out, d, -plane_op(w, o, d)};
-    shade(it, b, &h, emit_halves, &e);
+    shade(it, b, &h, d, emit_halves, &e);
+    if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES)
+        mirror_pol(w, b, ob, &h, d, level, weight, f, fr, out);
 }
 
 /* Power seen at the pixel.  Rays of incoherent sources add intensities;

@@ -124,6 +124,7 @@ typedef struct parser {
     size_t max_objects;
     const char *const *include_dirs;
     size_t n_include_dirs;
+    int no_include;         /* #include refused */
     double version;         /* #version (default 3.7) */
     unsigned long long budget; /* tokens left (loops and macros end) */
     scope *scopes;

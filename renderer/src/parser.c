@@ -2326,6 +2326,7 @@ static int parse_camera(parser *p)
                                                "omnimax", "panoramic", "cylinder",
                                                "spherical" };
     rs_camera *c = &p->scene->camera;
+    rs_token angle_tok = { RS_TOK_EOF, 0, 0, 0, 0, NULL, 0 };
     take(p);
     if (open_block(p, "camera") != 0)
         return -1;
@@ -2346,7 +2347,7 @@ static int parse_camera(parser *p)
         }
         if (is_id(t, "angle")) {
             rs_token start;
-            take(p);
+            angle_tok = take(p);
             start = *peek(p);
             if (parse_float(p, "the camera angle", &c->angle) != 0)
                 return -1;
@@ -2388,6 +2389,10 @@ static int parse_camera(parser *p)
         if (parse_vector(p, target) != 0)
             return -1;
     }
+    if (c->orthographic && c->has_angle)
+        return error_at(p, angle_tok.line, angle_tok.column,
+                        "angle with an orthographic camera is not supported: give right and "
+                        "up the size of the view");
     return close_block(p, "camera");
 }
 
@@ -2712,7 +2717,8 @@ int rs__parse_value(parser *p, val *out, const char *what)
         take(p);
         return 0;
     }
-    if (is_expr_start(p, t) || t->kind == RS_TOK_STRING)
+    if (is_expr_start(p, t) || t->kind == RS_TOK_STRING || is_id(t, "concat") ||
+        is_id(t, "str") || is_id(t, "chr"))
         return parse_expr(p, out);
     if (t->kind == RS_TOK_IDENT && is_reserved(t->text, t->len)) {
         char w[160];
@@ -2890,6 +2896,9 @@ static int parse_buffer(const char *text, size_t len, const char *name,
     if (opts != NULL) {
         p.include_dirs = opts->include_dirs;
         p.n_include_dirs = opts->n_include_dirs;
+        if (opts->max_tokens > 0)
+            p.budget = opts->max_tokens;
+        p.no_include = opts->no_include;
     }
     if (rs__scope_push(&p) != 0 || rs__push_file(&p, text, len, file, 1, 1) != 0) {
         set_msg(msg, msg_size, "%s: out of memory", name);

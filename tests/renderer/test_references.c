@@ -33,6 +33,7 @@
 #include "check.h"
 #include "image.h"
 #include "integrator.h"
+#include "library_path.h"
 #include "parser.h"
 #include "scene.h"
 #include "tiles.h"
@@ -122,6 +123,7 @@ static int render_scene(const char *name, rs_image *img)
     char path[4096], msg[1024] = "";
     rs_scene sc;
     rs_parse_opts po;
+    const char *dirs[4];
     rs_render_opts ro;
     rs_integrator *it = NULL;
     int rc = -1;
@@ -132,6 +134,8 @@ static int render_scene(const char *name, rs_image *img)
     rs_parse_opts_init(&po);
     po.image_width = REF_W;
     po.image_height = REF_H;
+    po.include_dirs = dirs;
+    po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
     rs_render_opts_init(&ro);
     ro.mode = RS_MODE_POLARIZED;
     ro.width = REF_W;
