@@ -882,7 +882,7 @@ static int parse_or(parser *p, val *out)
 }
 
 /* or [ ? expr : expr ] (both branches are read; one is kept). */
-static int parse_expr(parser *p, val *out)
+static int parse_ternary(parser *p, val *out)
 {
     rs_token q;
     val a, b;
@@ -914,6 +914,16 @@ static int parse_expr(parser *p, val *out)
     } else {
         *out = b;
         rs__val_free(&a);
+    }
+    return 0;
+}
+
+/* An expression; on failure *out holds nothing to free. */
+static int parse_expr(parser *p, val *out)
+{
+    if (parse_ternary(p, out) != 0) {
+        rs__val_free(out);
+        return -1;
     }
     return 0;
 }
@@ -2654,7 +2664,19 @@ static int alloc_payload(parser *p, const rs_token *at, val *out, val_kind kind,
     return 0;
 }
 
+static int parse_value(parser *p, val *out, const char *what);
+
+/* Any value; on failure *out holds nothing to free. */
 int rs__parse_value(parser *p, val *out, const char *what)
+{
+    if (parse_value(p, out, what) != 0) {
+        rs__val_free(out);
+        return -1;
+    }
+    return 0;
+}
+
+static int parse_value(parser *p, val *out, const char *what)
 {
     const rs_token *t = peek(p);
     rs_token at = *t;
