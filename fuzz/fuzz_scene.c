@@ -7,8 +7,9 @@
  * be finite, with unit normals and positive sizes (parser.h); any
  * crash, sanitizer report, leak, hang or runaway allocation is a bug; a
  * refusal must come with a "<fuzz>:LINE:COL: ..." message.  #include is
- * off (no file is read) and a parse reads at most 10^6 tokens, so that
- * #while loops and macro calls end fast. */
+ * off (no file is read), and a parse reads at most 10^5 tokens and makes
+ * at most 2000 objects, so that endless #while loops and macro calls end
+ * in milliseconds. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -127,7 +128,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     text[size] = '\0';
     rs_parse_opts_init(&opts);
     opts.no_include = 1;       /* no file is opened */
-    opts.max_tokens = 1000000; /* loops end fast */
+    opts.max_tokens = 100000;  /* loops and macro recursion end fast */
+    opts.max_objects = 2000;
     rs_scene_init(&scene);
     rc = rs_parse_string(text, "<fuzz>", &opts, &scene, msg, sizeof msg);
     if (rc != 0) {

@@ -428,8 +428,6 @@ static void test_many(void)
                 e = fmax(e, vlen(vsub(a->ray.vp, b->ray.vp)));
                 e = fmax(e, fabs(a->ray.op - b->ray.op) / fmax(1, fabs(b->ray.op)));
                 e = fmax(e, fabs(a->ray.phase - b->ray.phase));
-                if (b->ray.intensity == 0 && a->ray.intensity == 0)
-                    e = fmax(e, 0);
                 if (e > worst)
                     worst = e;
             }

@@ -213,18 +213,29 @@ static void run_case(const lens_case *c, const frame *f, int back)
     double zlast = back ? 0.0 : c->t, sgn = back ? -1.0 : 1.0;
     double a = c->D / 2;
 
-    snprintf(what, sizeof what, "%s%s paraxial h=1e-4a", c->name, back ? " (from behind)" : "");
-    double z1 = lib_crossing(lens, f, c->t, 1e-4 * a, back, what);
-    double b1 = sgn * (z1 - zlast);
-    CHECK_REL(b1, bfl, 1e-4, "%s: BFL vs thick-lens formula", what);
-    worst_parax = fmax(worst_parax, fabs(b1 / bfl - 1));
-
-    snprintf(what, sizeof what, "%s%s paraxial h=2e-4a", c->name, back ? " (from behind)" : "");
-    double z2 = lib_crossing(lens, f, c->t, 2e-4 * a, back, what);
-    double b2 = sgn * (z2 - zlast);
-    CHECK_REL(b2, bfl, 1e-4, "%s: BFL vs thick-lens formula", what);
+    /* A "paraxial" ray at height h still has the third-order spherical
+     * aberration LA(h) = LA(h0) (h/h0)^2, LA(h0) from the exact trace at
+     * h0 = 0.1a (up to 1.1e-8 of the BFL here).  What is left is the
+     * fifth-order part of LA(h0) carried into the extrapolation (measured
+     * <= 1.1e-3 of LA) and rounding in the axis crossing z - x dz/dx at
+     * slopes ~1e-5 (measured <= 3e-12 relative in the placed frames).
+     * Tolerance 1e-2 LA + 1e-11 relative; worst residual measured 1.2e-11
+     * (plano-convex from behind at 2e-4a, LA 1.1e-8). */
+    double h0 = 0.1 * a;
+    double la0 = bfl - sgn * ((double)exact_crossing(c->R1, c->R2, c->t, N_GLASS, h0, back) - zlast);
+    double hp[2] = {1e-4 * a, 2e-4 * a}, bp[2];
+    for (int i = 0; i < 2; i++) {
+        snprintf(what, sizeof what, "%s%s paraxial h=%ga", c->name, back ? " (from behind)" : "",
+                 hp[i] / a);
+        double z = lib_crossing(lens, f, c->t, hp[i], back, what);
+        bp[i] = sgn * (z - zlast);
+        double la = la0 * (hp[i] / h0) * (hp[i] / h0);
+        CHECK_ABS((bp[i] - (bfl - la)) / bfl, 0.0, 1e-2 * fabs(la / bfl) + 1e-11,
+                  "%s: BFL vs thick-lens formula minus third-order LA %.3g", what, la);
+        worst_parax = fmax(worst_parax, fabs(bp[i] / bfl - 1));
+    }
     /* LA(2h) - LA(h) ~ 3 k h^2 ~ 3e-9 relative here */
-    CHECK_REL(b2, b1, 1e-7, "%s%s: paraxial heights agree", c->name, back ? " (from behind)" : "");
+    CHECK_REL(bp[1], bp[0], 1e-7, "%s%s: paraxial heights agree", c->name, back ? " (from behind)" : "");
 
     /* exact real-ray crossings at several heights */
     const double fr[] = {1e-4, 0.1, 0.3, 0.45, 0.5, 0.7, 0.9};

@@ -277,6 +277,12 @@ static long leak_count; /* traces that raised LP_WARN_LEAK */
 static double denormal_vp_worst;
 static long denormal_vp_rays;
 
+/* One failed property of sane(): printed where it is found; sane() counts
+ * the trace as one check, failed when any property failed. */
+#define SANE_FAIL(...)                                                                   \
+    (fprintf(stderr, "%s:%d: ", __FILE__, __LINE__), fprintf(stderr, __VA_ARGS__),         \
+     fputc('\n', stderr))
+
 static int sane(const lp_result *res, int max_depth, const char *what)
 {
     int ok = 1;
@@ -288,16 +294,16 @@ static int sane(const lp_result *res, int max_depth, const char *what)
                   isfinite(r->intensity) && isfinite(r->op) && isfinite(r->phase) &&
                   isfinite(r->lambda_nm);
         if (!fin || !(vlen(r->vp) > 0.0)) {
-            CHECK(0, "%s: ray %zu (depth %d) is not finite (or vp = 0)", what, i, o->depth);
+            SANE_FAIL("%s: ray %zu (depth %d) is not finite (or vp = 0)", what, i, o->depth);
             ok = 0;
             continue;
         }
         if (!(r->intensity >= 0.0)) {
-            CHECK(0, "%s: ray %zu intensity %g < 0", what, i, r->intensity);
+            SANE_FAIL("%s: ray %zu intensity %g < 0", what, i, r->intensity);
             ok = 0;
         }
         if (!(o->depth >= 1 && o->depth <= max_depth) || !(o->part == 0 || o->part == 1)) {
-            CHECK(0, "%s: ray %zu depth %d part %d", what, i, o->depth, o->part);
+            SANE_FAIL("%s: ray %zu depth %d part %d", what, i, o->depth, o->part);
             ok = 0;
         }
         double dl = vlen(r->dir), pl = vlen(r->vp), pd = vdot(r->vp, r->dir);
@@ -306,7 +312,7 @@ static int sane(const lp_result *res, int max_depth, const char *what)
             denormal_vp_rays++;
         }
         if (!(fabs(dl - 1.0) <= 1e-12) || !(fabs(pl - 1.0) <= 1e-12) || !(fabs(pd) <= 1e-12)) {
-            CHECK(0, "%s: ray %zu (depth %d): |dir| - 1 = %g, |vp| - 1 = %g, vp.dir = %g", what,
+            SANE_FAIL("%s: ray %zu (depth %d): |dir| - 1 = %g, |vp| - 1 = %g, vp.dir = %g", what,
                   i, o->depth, dl - 1.0, pl - 1.0, pd);
             ok = 0;
         }
@@ -316,23 +322,23 @@ static int sane(const lp_result *res, int max_depth, const char *what)
                              res->absorbed_rim, res->truncated};
     for (int k = 0; k < 6; k++)
         if (!isfinite(terms[k]) || terms[k] < 0.0) {
-            CHECK(0, "%s: bookkeeping term %d = %g", what, k, terms[k]);
+            SANE_FAIL("%s: bookkeeping term %d = %g", what, k, terms[k]);
             ok = 0;
         }
     double bal = res->out + res->skipped + res->absorbed_glass + res->absorbed_rim + res->truncated;
     double tol = 1e-12 * res->in + 256.0 * DBL_TRUE_MIN;
     if (!(fabs(bal - res->in) <= tol)) {
-        CHECK(0, "%s: in %.17g != out+skipped+absorbed+truncated %.17g (diff %g, tol %g)", what,
+        SANE_FAIL("%s: in %.17g != out+skipped+absorbed+truncated %.17g (diff %g, tol %g)", what,
               res->in, bal, bal - res->in, tol);
         ok = 0;
     }
     if (!(fabs(res->out - sum) <= 1e-13 * sum + 256.0 * DBL_TRUE_MIN)) {
-        CHECK(0, "%s: out %.17g != sum of intensities %.17g", what, res->out, sum);
+        SANE_FAIL("%s: out %.17g != sum of intensities %.17g", what, res->out, sum);
         ok = 0;
     }
     if (res->warnings & LP_WARN_LEAK)
         leak_count++;
-    CHECK(1, "%s: sane", what);
+    CHECK(ok, "%s: every ray finite and unit, bookkeeping balanced", what);
     return ok;
 }
 

@@ -375,30 +375,84 @@ static int segment_meets_rim(const lp_lens *lens, lp_vec3 x, lp_vec3 d, double t
     return 0;
 }
 
-/* Is the light at `to` visible from x?  Clear glass and polarizers cast
- * no shadow (as in POV-Ray); a lens rim and opaque objects do. */
-static int visible(const rs_scene *sc, lp_vec3 x, lp_vec3 to)
+/* The fraction of light k's power that reaches x along the straight
+ * segment between them: 0 where a lens rim or an opaque object is in the
+ * way (clear glass casts no shadow, as in POV-Ray), else the product of
+ * what the polarizers on the segment pass.  In the polarized mode the
+ * light leaves as its own linear polarization (`polarization <v>`, made
+ * perpendicular to the segment) or as natural light (two orthogonal
+ * incoherent halves), and each polarizer, from the light on, projects it
+ * on its axis (Malus's law, the axis taken perpendicular to the segment,
+ * as for camera rays); the unpolarized models pass half at each. */
+#define RS_SHADOW_POLARIZERS 16
+static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
 {
-    lp_vec3 d = {to.x - x.x, to.y - x.y, to.z - x.z};
+    const rs_scene *sc = it->scene;
+    const rs_light *l = &sc->lights[k];
+    lp_vec3 d = {l->position.x - x.x, l->position.y - x.y, l->position.z - x.z};
     double dist = sqrt(dot(d, d));
     if (!(dist > 0.0))
-        return 1;
+        return 1.0;
     d = (lp_vec3){d.x / dist, d.y / dist, d.z / dist};
     double eps = 1e-9 * (1.0 + sqrt(dot(x, x)));
+    size_t pol[RS_SHADOW_POLARIZERS];
+    double tpol[RS_SHADOW_POLARIZERS];
+    int np = 0;
     for (size_t i = 0; i < sc->n_objects; i++) {
         const rs_object *o = &sc->objects[i];
         rs_hit h;
-        if (o->type == RS_OBJ_POLARIZER)
-            continue;
         if (o->type == RS_OBJ_LENS) {
             if (o->lens && segment_meets_rim(o->lens, x, d, eps, dist))
-                return 0;
+                return 0.0;
             continue;
         }
-        if (rs_object_intersect(o, x, d, eps, dist, &h))
-            return 0;
+        if (!rs_object_intersect(o, x, d, eps, dist, &h))
+            continue;
+        if (o->type != RS_OBJ_POLARIZER)
+            return 0.0;
+        if (np == RS_SHADOW_POLARIZERS)
+            return 0.0; /* more than any stack of ideal polarizers needs */
+        /* keep them sorted from the light (far end) towards x */
+        int at = np++;
+        while (at > 0 && tpol[at - 1] < h.t) {
+            pol[at] = pol[at - 1];
+            tpol[at] = tpol[at - 1];
+            at--;
+        }
+        pol[at] = i;
+        tpol[at] = h.t;
     }
-    return 1;
+    if (np == 0)
+        return 1.0;
+    if (it->opts.mode != RS_MODE_POLARIZED)
+        return ldexp(1.0, -np);
+    /* the light's state: up to two linear, mutually incoherent parts */
+    double I[2];
+    lp_vec3 v[2];
+    int nv;
+    lp_vec3 pv = l->polarization;
+    pv = madd(pv, d, -dot(pv, d));
+    if (l->polarized && dot(pv, pv) > 0.0) {
+        nv = 1;
+        I[0] = 1.0;
+        v[0] = unit(pv);
+    } else {
+        lp_vec3 hh = fabs(d.y) < 0.9 ? (lp_vec3){0, 1, 0} : (lp_vec3){1, 0, 0};
+        nv = 2;
+        I[0] = I[1] = 0.5;
+        v[0] = unit(cross(d, hh));
+        v[1] = cross(d, v[0]);
+    }
+    for (int q = 0; q < np; q++) {
+        lp_vec3 ax = sc->objects[pol[q]].u.polarizer.axis;
+        ax = unit(madd(ax, d, -dot(ax, d)));
+        for (int m = 0; m < nv; m++) {
+            double c = dot(v[m], ax);
+            I[m] *= c * c;
+            v[m] = ax;
+        }
+    }
+    return nv == 1 ? I[0] : I[0] + I[1];
 }
 
 /* Light leaving a diffuse/emissive surface towards the viewer, per source:
@@ -458,7 +512,10 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_ve
         if (diff + s <= 0.0)
             continue;
         double p = band_light(it, b, (int)k);
-        if (p == 0.0 || !visible(sc, x, l->position))
+        if (p == 0.0)
+            continue;
+        p *= light_reach(it, x, (int)k);
+        if (p == 0.0)
             continue;
         emit(ctx, src_light(it, (int)k), (diff + s) * p);
     }

@@ -13,16 +13,25 @@
  *     written first stays byte-for-byte the same after a run with a
  *     broken scene aimed at the same paths, and after a run that cannot
  *     write its PFM (exit 1);
- *   - every --wavelengths count the option accepts (1..1024) renders. */
+ *   - --threads 1, 2, 3, 7 and 64 give the same bytes;
+ *   - --wavelengths over 1..1024: a directly seen emitter renders as its
+ *     RGB (0 and 1025 refused);
+ *   - --depth and --cutoff change a plate's transmission as the series of
+ *     its internal reflections says;
+ *   - the progress line on a terminal (a pseudo-terminal), none with
+ *     --quiet or on a pipe. */
 #define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700 /* posix_openpt, grantpt, unlockpt, ptsname */
 
 #include <dirent.h>
+#include <fcntl.h>
 #include <errno.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "check.h"
@@ -295,6 +304,21 @@ static void test_threads_identical(void)
           "--threads 1 and --threads 2 give byte-identical PFM files (%zu, %zu bytes)", l1, l2);
     CHECK(g1 && g2 && m1 == m2 && memcmp(g1, g2, m1) == 0,
           "--threads 1 and --threads 2 give byte-identical PNG files");
+    /* More threads than cores, an odd count, more threads than the 96x72
+     * image has tiles: the same bytes. */
+    static const char *const more[] = {"3", "7", "64"};
+    for (size_t k = 0; k < sizeof more / sizeof *more; k++) {
+        const char *an[] = {DEFAULT_SCENE, "-o", png2, "--pfm", pfm2, "--width", "96",
+                            "--height", "72", "--threads", more[k], "--quiet", NULL};
+        proc pn = run_argv(an);
+        CHECK(pn.status == 0, "%s: exit %d, stderr: %s", pn.what, pn.status, pn.err);
+        size_t ln = 0;
+        unsigned char *fn = read_all(pfm2, &ln);
+        CHECK(f1 && fn && l1 == ln && memcmp(f1, fn, l1) == 0,
+              "--threads 1 and --threads %s give byte-identical PFM files", more[k]);
+        free(fn);
+        proc_free(&pn);
+    }
     /* not an all-black (or all-equal) render: the scene is there */
     if (f1 && l1 > 64) {
         size_t hl = strlen("PF\n96 72\n-1.0\n");
@@ -416,20 +440,281 @@ static void test_bad_input(void)
     remove_dir(src);
 }
 
-/* --wavelengths takes 1..1024 (args.h, --help): every count renders. */
+/* The linear RGB of pixel k of a PFM written by lensrender (bottom-up rows,
+ * little-endian floats: the header says -1.0); 0 on success. */
+static int pfm_pixel(const char *path, int w, int h, int i, int j, double rgb[3])
+{
+    size_t len = 0;
+    unsigned char *b = read_all(path, &len);
+    char head[64];
+    int hl = snprintf(head, sizeof head, "PF\n%d %d\n-1.0\n", w, h);
+    int rc = -1;
+    if (b && len == (size_t)hl + (size_t)w * h * 12 && memcmp(b, head, (size_t)hl) == 0) {
+        const unsigned char *p = b + hl + 12 * ((size_t)(h - 1 - j) * w + i);
+        for (int c = 0; c < 3; c++) {
+            uint32_t u = (uint32_t)p[4 * c] | (uint32_t)p[4 * c + 1] << 8 |
+                         (uint32_t)p[4 * c + 2] << 16 | (uint32_t)p[4 * c + 3] << 24;
+            float f;
+            memcpy(&f, &u, sizeof f);
+            rgb[c] = f;
+        }
+        rc = 0;
+    }
+    free(b);
+    return rc;
+}
+
+/* Render scene text at w x h with extra arguments; fills rgb with pixel
+ * (i, j) of the PFM.  0 on success. */
+static int render_text(const char *dir, const char *text, int w, int h, const char *const *extra,
+                       int i, int j, double rgb[3])
+{
+    char scene[4300], png[4300], pfm[4300], ws[16], hs[16];
+    const char *a[32];
+    size_t n = 0;
+    snprintf(scene, sizeof scene, "%s/s.scene", dir);
+    snprintf(png, sizeof png, "%s/s.png", dir);
+    snprintf(pfm, sizeof pfm, "%s/s.pfm", dir);
+    snprintf(ws, sizeof ws, "%d", w);
+    snprintf(hs, sizeof hs, "%d", h);
+    if (write_text(scene, text) != 0)
+        return -1;
+    a[n++] = scene;
+    const char *fixed[] = {"-o", png, "--pfm", pfm, "--width", ws, "--height", hs, "--quiet"};
+    for (size_t k = 0; k < sizeof fixed / sizeof *fixed; k++)
+        a[n++] = fixed[k];
+    for (size_t k = 0; extra && extra[k] && n + 1 < sizeof a / sizeof *a; k++)
+        a[n++] = extra[k];
+    a[n] = NULL;
+    proc p = run_argv(a);
+    int rc = p.status == 0 ? pfm_pixel(pfm, w, h, i, j, rgb) : -1;
+    if (p.status != 0)
+        fprintf(stderr, "%s: exit %d: %s", p.what, p.status, p.err);
+    proc_free(&p);
+    return rc;
+}
+
+/* PFM values are floats: half an ulp, 6e-8 relative, is all a correct
+ * value may be off by after the doubles are rounded. */
+#define FLOAT_TOL 1.2e-7
+
+/* --wavelengths takes 1..1024 (args.h, --help).  A directly seen RGB
+ * emitter renders as exactly its RGB whatever the count >= 3 (the colour
+ * correction; test_spectrum checks its rounding), and with 1 or 2
+ * wavelengths as grey (luminance only; white as 1): checked over the
+ * range, to the PFM's float precision (measured 4e-8). */
 static void test_wavelength_counts(void)
 {
-    char dir[4096], png[4200];
-    static const char *const counts[] = {"1", "2", "3", "16"};
+    char dir[4096], text[256];
+    static const char *const counts[] = {"1", "2", "3", "5", "16", "100", "1024"};
+    static const double cols[2][3] = {{1, 1, 1}, {0.8, 0.3, 0.1}};
     fresh_dir(dir, sizeof dir, "wavelengths");
-    snprintf(png, sizeof png, "%s/w.png", dir);
-    for (size_t k = 0; k < sizeof counts / sizeof *counts; k++) {
-        const char *a[] = {DEFAULT_SCENE, "-o", png, "--width", "8", "--height", "6",
-                           "--wavelengths", counts[k], "--quiet", NULL};
+    for (size_t k = 0; k < sizeof counts / sizeof *counts; k++)
+        for (int c = 0; c < 2; c++) {
+            snprintf(text, sizeof text,
+                     "camera { location <0, 0, 0> look_at <0, 0, 1> angle 10 }\n"
+                     "background { rgb <%g, %g, %g> }\n", cols[c][0], cols[c][1], cols[c][2]);
+            const char *extra[] = {"--wavelengths", counts[k], NULL};
+            double rgb[3];
+            if (render_text(dir, text, 2, 2, extra, 1, 1, rgb) != 0) {
+                CHECK(0, "--wavelengths %s renders", counts[k]);
+                continue;
+            }
+            if (c == 1 && atoi(counts[k]) < 3) {
+                /* no colour from one or two wavelengths: grey */
+                CHECK(rgb[0] == rgb[1] && rgb[1] == rgb[2] && rgb[0] > 0,
+                      "--wavelengths %s: a coloured emitter renders grey (%g %g %g)", counts[k],
+                      rgb[0], rgb[1], rgb[2]);
+                continue;
+            }
+            for (int ch = 0; ch < 3; ch++)
+                CHECK_REL(rgb[ch], cols[c][ch], FLOAT_TOL,
+                          "--wavelengths %s: emitter (%g %g %g) channel %d", counts[k],
+                          cols[c][0], cols[c][1], cols[c][2], ch);
+        }
+    static const char *const bad[] = {"0", "1025"};
+    for (size_t k = 0; k < 2; k++) {
+        const char *a[] = {DEFAULT_SCENE, "--wavelengths", bad[k], "--quiet", NULL};
         proc p = run_argv(a);
-        CHECK(p.status == 0, "%s: exit %d: %s", p.what, p.status, p.err);
+        CHECK(p.status == 2, "--wavelengths %s refused: exit %d", bad[k], p.status);
         proc_free(&p);
     }
+    remove_dir(dir);
+}
+
+/* --depth and --cutoff on the command line, on a lossless plate (n 1.5168,
+ * R = ((n-1)/(n+1))^2 = 0.0422) in front of a self-lit plane, seen at
+ * normal incidence in the rgb mode.  A path with 2k internal reflections
+ * reaches the plane at trace level 3 + 2k and carries (1-R)^2 R^2k; inside
+ * the glass, before leaving, its weight is (1-R) R^2k.  So --depth N keeps
+ * the paths with 3 + 2k <= N (N = 2: the plane is out of reach, black;
+ * 3, 4: (1-R)^2; 5, 6: (1-R)^2 (1 + R^2)) and --cutoff F those with
+ * (1-R) R^2k >= F (thresholds 1.70e-3 and 3.03e-6: checked 10 % either
+ * side).  The scene's own max_trace_level 60 and adc_bailout 1e-12 give
+ * the whole series, (1-R)/(1+R), 3.1e-6 above one round trip. */
+static void test_depth_cutoff(void)
+{
+    char dir[4096];
+    const char *scene =
+        "global_settings { max_trace_level 60 adc_bailout 1e-12 }\n"
+        "camera { location <0, 0, -100> look_at <0, 0, 0> right x angle 2 }\n"
+        "background { rgb 0 }\n"
+        "lens { radius1 0 radius2 0 thickness 2 diameter 200 ior 1.5168 translate <0, 0, -1> }\n"
+        "plane { z, 50 pigment { rgb 1 } finish { ambient 0 diffuse 0 emission 1 } }\n";
+    const double n = 1.5168, r = (n - 1) / (n + 1), R = r * r;
+    const double t0 = (1 - R) * (1 - R), t1 = t0 * (1 + R * R), tall = (1 - R) / (1 + R);
+    const double c1 = (1 - R) * R * R, c2 = c1 * R * R;
+    char c1a[32], c1b[32], c2a[32], c2b[32];
+    snprintf(c1a, sizeof c1a, "%.6g", 1.1 * c1);
+    snprintf(c1b, sizeof c1b, "%.6g", 0.9 * c1);
+    snprintf(c2a, sizeof c2a, "%.6g", 1.1 * c2);
+    snprintf(c2b, sizeof c2b, "%.6g", 0.9 * c2);
+    const struct { const char *opt, *val; double want; } cases[] = {
+        {NULL, NULL, tall},        {"--depth", "2", 0.0},  {"--depth", "3", t0},
+        {"--depth", "4", t0},      {"--depth", "5", t1},   {"--depth", "6", t1},
+        {"--cutoff", c1a, t0},     {"--cutoff", c1b, t1},  {"--cutoff", c2a, t1},
+        {"--cutoff", c2b, tall},   {"--cutoff", "0", tall},
+    };
+    fresh_dir(dir, sizeof dir, "depth_cutoff");
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        const char *extra[] = {"--mode", "rgb", cases[k].opt, cases[k].val, NULL};
+        double rgb[3];
+        if (render_text(dir, scene, 1, 1, extra, 0, 0, rgb) != 0) {
+            CHECK(0, "%s %s renders", cases[k].opt ? cases[k].opt : "(scene's)",
+                  cases[k].val ? cases[k].val : "");
+            continue;
+        }
+        for (int ch = 0; ch < 3; ch++)
+            CHECK_ABS(rgb[ch], cases[k].want, FLOAT_TOL * cases[k].want + 1e-30,
+                      "plate with %s %s: channel %d", cases[k].opt ? cases[k].opt : "(scene's)",
+                      cases[k].val ? cases[k].val : "settings", ch);
+    }
+    remove_dir(dir);
+}
+
+/* Run lensrender with its stderr (and stdout) on a pseudo-terminal;
+ * returns what the terminal received (malloc'd, NUL-terminated) and the
+ * exit status, or NULL when no pseudo-terminal can be had. */
+static char *run_on_terminal(const char *const *args, int *status)
+{
+    int m = posix_openpt(O_RDWR | O_NOCTTY);
+    if (m < 0)
+        return NULL;
+    char *name = (grantpt(m) == 0 && unlockpt(m) == 0) ? ptsname(m) : NULL;
+    if (name == NULL) {
+        close(m);
+        return NULL;
+    }
+    char slave[256];
+    snprintf(slave, sizeof slave, "%s", name);
+    pid_t pid = fork();
+    if (pid < 0) {
+        close(m);
+        return NULL;
+    }
+    if (pid == 0) {
+        setsid();
+        int s = open(slave, O_RDWR);
+        if (s < 0)
+            _exit(126);
+        dup2(s, 1);
+        dup2(s, 2);
+        if (s > 2)
+            close(s);
+        close(m);
+        int i = 0;
+        const char *argv[40];
+        argv[i++] = LENSRENDER;
+        for (; args[i - 1] && i < 39; i++)
+            argv[i] = args[i - 1];
+        argv[i] = NULL;
+        execv(LENSRENDER, (char *const *)argv);
+        _exit(127);
+    }
+    size_t cap = 4096, len = 0;
+    char *buf = malloc(cap);
+    for (;;) {
+        if (buf && len + 1024 > cap) {
+            char *nb = realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+            } else {
+                buf = nb;
+                cap *= 2;
+            }
+        }
+        char tmp[1024];
+        ssize_t r = read(m, tmp, sizeof tmp);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            break; /* EIO: the last slave descriptor closed */
+        if (buf) {
+            memcpy(buf + len, tmp, (size_t)r);
+            len += (size_t)r;
+        }
+    }
+    close(m);
+    int st = 0;
+    waitpid(pid, &st, 0);
+    *status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + (WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+    if (buf)
+        buf[len] = '\0';
+    return buf;
+}
+
+/* The progress line (README, --quiet): on a terminal lensrender redraws
+ * "\r[bar of 30] NNN%  ..." as tiles finish and ends with the full bar at
+ * 100 % and a newline; --quiet prints nothing; on a pipe (every other
+ * test here) there is no progress line. */
+static void test_progress(void)
+{
+    char dir[4096], png[4200];
+    fresh_dir(dir, sizeof dir, "progress");
+    snprintf(png, sizeof png, "%s/p.png", dir);
+    const char *a[] = {DEFAULT_SCENE, "-o", png, "--width", "64", "--height", "48", NULL};
+    int st = -1;
+    char *t = run_on_terminal(a, &st);
+    if (t == NULL) {
+        CHECK(0, "a pseudo-terminal for the progress test");
+        remove_dir(dir);
+        return;
+    }
+    CHECK(st == 0, "on a terminal: exit %d: %s", st, t);
+    int updates = 0, monotone = 1, last = -1, full = 0;
+    for (const char *p = t; (p = strstr(p, "\r[")) != NULL; p++) {
+        int bar = 0, ok = 1, pct = -1;
+        const char *q = p + 2;
+        for (; *q == '#' || *q == '.'; q++)
+            bar++;
+        ok = bar == 30 && *q == ']' && sscanf(q + 1, "%d%%", &pct) == 1;
+        CHECK(ok, "progress line: a bar of 30 and a percentage: [%.60s]", p + 1);
+        if (!ok)
+            continue;
+        updates++;
+        monotone &= pct >= last;
+        last = pct;
+        if (pct == 100 && strncmp(p + 2, "##############################]", 31) == 0)
+            full = 1;
+    }
+    CHECK(updates >= 2, "progress: %d updates on a terminal, want the 0 %% and the final one",
+          updates);
+    CHECK(monotone && last == 100 && full, "progress: rises to a full bar at 100 %% (last %d)",
+          last);
+    const char *end = strstr(t, "100%");
+    CHECK(end != NULL && strchr(end, '\n') != NULL, "progress: the final line ends with a newline");
+    free(t);
+    const char *aq[] = {DEFAULT_SCENE, "-o", png, "--width", "64", "--height", "48", "--quiet",
+                        NULL};
+    t = run_on_terminal(aq, &st);
+    CHECK(t != NULL && st == 0 && t[0] == '\0', "--quiet on a terminal prints nothing: [%s]",
+          t ? t : "");
+    free(t);
+    proc p = run_argv(a);
+    CHECK(p.status == 0 && strstr(p.err, "\r[") == NULL && strstr(p.err, "%") == NULL,
+          "on a pipe: no progress line: [%s]", p.err);
+    proc_free(&p);
     remove_dir(dir);
 }
 
@@ -440,6 +725,8 @@ int main(void)
     test_threads_identical();
     test_bad_input();
     test_wavelength_counts();
+    test_depth_cutoff();
+    test_progress();
     snprintf(top, sizeof top, "%s/lensrender_cli.%ld", LP_TEST_TMP, (long)getpid());
     rmdir(top);
     return check_finish("test_lensrender_cli");
