@@ -564,27 +564,22 @@ static void put_shape(FILE *out, const rs_object *o, int turn, double k)
         fputs("\n", out);
         break;
     case RS_OBJ_CYLINDER:
-        fputs("cylinder { ", out);
-        put_vec(out, o->u.cylinder.base);
+    case RS_OBJ_CONE: {
+        int cone = o->type == RS_OBJ_CONE;
+        fputs(cone ? "cone { " : "cylinder { ", out);
+        put_vec(out, cone ? o->u.cone.base : o->u.cylinder.base);
+        if (cone) {
+            fputs(", ", out);
+            put_num(out, o->u.cone.base_radius);
+        }
         fputs(", ", out);
-        put_vec(out, o->u.cylinder.cap);
+        put_vec(out, cone ? o->u.cone.cap : o->u.cylinder.cap);
         fputs(", ", out);
-        put_num(out, o->u.cylinder.radius);
-        fputs(o->u.cylinder.open ? " open" : "", out);
+        put_num(out, cone ? o->u.cone.cap_radius : o->u.cylinder.radius);
+        fputs((cone ? o->u.cone.open : o->u.cylinder.open) ? " open" : "", out);
         fputs(turn ? " inverse\n" : "\n", out);
         break;
-    case RS_OBJ_CONE:
-        fputs("cone { ", out);
-        put_vec(out, o->u.cone.base);
-        fputs(", ", out);
-        put_num(out, o->u.cone.base_radius);
-        fputs(", ", out);
-        put_vec(out, o->u.cone.cap);
-        fputs(", ", out);
-        put_num(out, o->u.cone.cap_radius);
-        fputs(o->u.cone.open ? " open" : "", out);
-        fputs(turn ? " inverse\n" : "\n", out);
-        break;
+    }
     case RS_OBJ_TORUS:
         fputs("torus { ", out);
         put_num(out, o->u.torus.major);

@@ -1959,71 +1959,56 @@ static int parse_polarizer(parser *p, rs_object *o, const rs_token *kw)
     return close_block(p, "polarizer");
 }
 
-/* cylinder { BASE, CAP, R [open] ... } */
-static int parse_cylinder(parser *p, rs_object *o, const rs_token *kw)
+/* cylinder { BASE, CAP, R [open] ... } and cone { BASE, R1, CAP, R2 [open]
+ * ... }: one reader, the cone reading a radius after each point. */
+static int parse_round(parser *p, rs_object *o, int cone)
 {
-    rs_token start;
+    const char *name = cone ? "cone" : "cylinder";
+    rs_token start, rtok;
     lp_vec3 a, b;
-    if (open_block(p, "cylinder") != 0 || parse_vector(p, &a) != 0)
+    double r1 = 0.0, r2;
+    int open = 0;
+    if (open_block(p, name) != 0 || parse_vector(p, &a) != 0)
         return -1;
     skip_comma(p);
-    start = *peek(p);
-    if (parse_vector(p, &b) != 0)
-        return -1;
-    if (a.x == b.x && a.y == b.y && a.z == b.z)
-        return error_at(p, start.line, start.column,
-                        "the cylinder's base and cap points must differ");
-    skip_comma(p);
-    start = *peek(p);
-    if (parse_float(p, "the cylinder radius", &o->u.cylinder.radius) != 0)
-        return -1;
-    if (!(o->u.cylinder.radius > 0.0))
-        return error_at(p, start.line, start.column, "the cylinder radius must be positive");
-    o->u.cylinder.base = a;
-    o->u.cylinder.cap = b;
-    if (is_id(peek(p), "open")) {
-        take(p);
-        o->u.cylinder.open = 1;
+    rtok = *peek(p);
+    if (cone) {
+        if (parse_float(p, "the cone's base radius", &r1) != 0)
+            return -1;
+        skip_comma(p);
     }
-    (void)kw;
-    return parse_object_modifiers(p, o);
-}
-
-/* cone { BASE, R1, CAP, R2 [open] ... } */
-static int parse_cone(parser *p, rs_object *o, const rs_token *kw)
-{
-    rs_token start, r1tok;
-    lp_vec3 a, b;
-    double r1, r2;
-    if (open_block(p, "cone") != 0 || parse_vector(p, &a) != 0)
-        return -1;
-    skip_comma(p);
-    r1tok = *peek(p);
-    if (parse_float(p, "the cone's base radius", &r1) != 0)
-        return -1;
-    skip_comma(p);
     start = *peek(p);
     if (parse_vector(p, &b) != 0)
         return -1;
     if (a.x == b.x && a.y == b.y && a.z == b.z)
-        return error_at(p, start.line, start.column,
-                        "the cone's base and cap points must differ");
+        return error_at(p, start.line, start.column, "the %s's base and cap points must differ",
+                        name);
     skip_comma(p);
-    start = *peek(p);
-    if (parse_float(p, "the cone's cap radius", &r2) != 0)
+    if (!cone)
+        rtok = *peek(p);
+    if (parse_float(p, cone ? "the cone's cap radius" : "the cylinder radius", &r2) != 0)
         return -1;
-    if (!(r1 >= 0.0) || !(r2 >= 0.0) || !(r1 > 0.0 || r2 > 0.0))
-        return error_at(p, r1tok.line, r1tok.column,
+    if (cone && (!(r1 >= 0.0) || !(r2 >= 0.0) || !(r1 > 0.0 || r2 > 0.0)))
+        return error_at(p, rtok.line, rtok.column,
                         "the cone's radii must be at least 0, and one of them positive");
-    o->u.cone.base = a;
-    o->u.cone.cap = b;
-    o->u.cone.base_radius = r1;
-    o->u.cone.cap_radius = r2;
+    if (!cone && !(r2 > 0.0))
+        return error_at(p, rtok.line, rtok.column, "the cylinder radius must be positive");
     if (is_id(peek(p), "open")) {
         take(p);
-        o->u.cone.open = 1;
+        open = 1;
     }
-    (void)kw;
+    if (cone) {
+        o->u.cone.base = a;
+        o->u.cone.cap = b;
+        o->u.cone.base_radius = r1;
+        o->u.cone.cap_radius = r2;
+        o->u.cone.open = open;
+    } else {
+        o->u.cylinder.base = a;
+        o->u.cylinder.cap = b;
+        o->u.cylinder.radius = r2;
+        o->u.cylinder.open = open;
+    }
     return parse_object_modifiers(p, o);
 }
 
@@ -2058,8 +2043,8 @@ static int parse_primitive(parser *p, rs_object_type type, rs_group *g)
     case RS_OBJ_BOX: rc = parse_box(p, &o); break;
     case RS_OBJ_DISC: rc = parse_disc(p, &o); break;
     case RS_OBJ_LENS: rc = parse_lens(p, &o, &kw); break;
-    case RS_OBJ_CYLINDER: rc = parse_cylinder(p, &o, &kw); break;
-    case RS_OBJ_CONE: rc = parse_cone(p, &o, &kw); break;
+    case RS_OBJ_CYLINDER: rc = parse_round(p, &o, 0); break;
+    case RS_OBJ_CONE: rc = parse_round(p, &o, 1); break;
     case RS_OBJ_TORUS: rc = parse_torus(p, &o, &kw); break;
     default: rc = parse_polarizer(p, &o, &kw); break;
     }

@@ -74,7 +74,7 @@ static const struct {
     {"newtons_rings.scene", 52.0},      /* 59.65 */
     {"plan_view.scene", 64.0},          /* 71.96 */
     {"plano_convex.scene", 95.0},       /* 102.77 */
-    {"polariscope.scene", 20.0},        /* (polarizers) */
+    {"polariscope.scene", 100.0},       /* inf: identical after clipping (polarizers) */
 };
 
 /* The bar of a scene: its own at 320 x 240, 40 dB at other sizes (or none
