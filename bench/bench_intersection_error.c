@@ -11,7 +11,7 @@
  *   inside:  from a uniform point of the flat back cap (a ray that starts
  *            on the lens) to a uniform point of the front cap.
  * The reference is a solver of the same Spencer & Murty quadratic written
- * here from the geometry in ref_real (tests/ref_real.h: IEEE binary128,
+ * here from the geometry in ref_real (tests/common/ref_real.h: IEEE binary128,
  * 113-bit significand, where the compiler has it; else long double),
  * taking the double ray exactly as given (its direction normalized in
  * that precision), so the measured error includes everything the library
@@ -330,7 +330,7 @@ static void print_page_tail(double worst_hit, double worst_cos, const char *wors
            "  curvature goes to 0 and is the plane at c = 0.\n\n"
            "The normal error is the hit error divided by |R| (the normal of a\n"
            "sphere turns by dhit/|R|) plus one rounding.  The stability test\n"
-           "(tests/test_stability.c, section \"radii\") checks every such ray\n"
+           "(tests/lensprim/test_stability.c, section \"radii\") checks every such ray\n"
            "against 32 DBL_EPSILON (distance + size)/|cos i| for the point.\n\n"
            "Regenerate this page with\n\n"
            "    cmake --build build --target bench_intersection_error\n"

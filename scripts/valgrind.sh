@@ -12,7 +12,7 @@
 #
 # Children: lensrender, lenstrace, pov_compare and model_limits, run by the
 # CLI tests, are traced and checked like the tests.  Not traced: system
-# programs (/bin, /usr/bin: the shell, POV-Ray) and tests/tools/measure_child,
+# programs (/bin, /usr/bin: the shell, POV-Ray) and tests/common/measure_child,
 # which runs the programs whose peak memory test_hostile_scenes bounds --
 # memcheck's own memory would be counted in that peak, so those runs are
 # native (their code paths are memchecked by the other tests).

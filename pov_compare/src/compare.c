@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "compare.h"
-#include "spectrum.h"
+#include "support/colorimetry.h"
 
 static float clip01(float v)
 {

@@ -26,7 +26,7 @@
 
 #include <stddef.h>
 
-#include "image.h"
+#include "support/image.h"
 
 typedef struct pc_metrics {
     double rmse;

@@ -23,7 +23,7 @@
 
 #include "camera.h"
 #include "compare.h"
-#include "image.h"
+#include "support/image.h"
 #include "integrator.h"
 #include "library_path.h"
 #include "montage.h"
@@ -31,7 +31,7 @@
 #include "povray.h"
 #include "report.h"
 #include "scene.h"
-#include "tiles.h"
+#include "support/tiles.h"
 #include "translate.h"
 
 #define EXIT_RENDER 1

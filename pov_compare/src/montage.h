@@ -16,7 +16,7 @@
 
 #include <stddef.h>
 
-#include "image.h"
+#include "support/image.h"
 
 typedef struct pc_montage_args {
     const rs_image *ours;     /* linear RGB; clipped to [0, 1] when drawn */

@@ -18,7 +18,7 @@
 
 #include <stddef.h>
 
-#include "image.h"
+#include "support/image.h"
 #include "scene.h"
 #include "translate.h"
 

@@ -33,7 +33,7 @@
 #include <string.h>
 
 #include "camera.h"
-#include "spectrum.h"
+#include "emitter.h"
 
 #define PC_PI 3.14159265358979323846
 /* pc_pov_scale's largest factor.  Rays bent by a lens can travel far

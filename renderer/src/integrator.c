@@ -35,7 +35,7 @@
 #include "camera.h"
 #include "integrator.h"
 #include "shapes.h"
-#include "spectrum.h"
+#include "emitter.h"
 
 #define RS_MAX_FRAMES 400
 #define RS_PI 3.14159265358979323846

@@ -13,12 +13,12 @@
 
 #include "args.h"
 #include "camera.h"
-#include "image.h"
+#include "support/image.h"
 #include "integrator.h"
 #include "library_path.h"
 #include "parser.h"
 #include "scene.h"
-#include "tiles.h"
+#include "support/tiles.h"
 
 #define EXIT_RENDER 1
 #define EXIT_BAD 2

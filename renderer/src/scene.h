@@ -12,10 +12,7 @@
 #include <stddef.h>
 
 #include "lensprim.h"
-
-typedef struct rs_color {
-    double r, g, b;
-} rs_color;
+#include "support/colorimetry.h" /* rs_color */
 
 /* x_world = m * x_object + t  (m row-major 3x3), with its inverse. */
 typedef struct rs_transform {
@@ -69,7 +66,7 @@ typedef struct rs_finish {
 } rs_finish;
 
 /* A spectrum of an emitter.  RGB colours become spectra by the method in
- * spectrum.h; a LINE is monochromatic (a delta of the given power). */
+ * emitter.h; a LINE is monochromatic (a delta of the given power). */
 typedef enum rs_spectrum_type {
     RS_SPECTRUM_RGB = 0,
     RS_SPECTRUM_BLACKBODY,

@@ -13,8 +13,8 @@
  *   - nesting 10^5 deep (parentheses, vectors, calls, blocks, comments,
  *     unary signs): a clean error or a clean parse, no stack overflow;
  *   - 10^6 objects: refused at the object limit (100,000 by default), in a
- *     separate program (tests/tools/parse_many) whose own peak memory is
- *     measured (tests/tools/measure_child), checked and printed;
+ *     separate program (tests/renderer/parse_many) whose own peak memory is
+ *     measured (tests/common/measure_child), checked and printed;
  *   - every prefix of every .scene file in scenes/ (truncation at each byte),
  *     and prefixes followed by junk;
  *   - binary junk (random bytes with NULs, from files) and a file larger
@@ -500,7 +500,7 @@ typedef struct run_result {
 } run_result;
 
 /* Run program with args through measure_child, which reports the
- * program's own peak RSS (see tests/tools/measure_child.c: a child forked
+ * program's own peak RSS (see tests/common/measure_child.c: a child forked
  * from this process would count this process's memory, and under valgrind
  * or ASan that is the tool's).  fsize_limit > 0 sets RLIMIT_FSIZE, with
  * SIGXFSZ ignored, so writes fail with EFBIG.  stdout and stderr are
@@ -527,7 +527,7 @@ static run_result run_measured(const char *program, const char *const *args, lon
 
 /* ---- 10^6 objects ------------------------------------------------------- */
 
-/* Parse `count` copies of `item` in tests/tools/parse_many; returns its peak
+/* Parse `count` copies of `item` in tests/renderer/parse_many; returns its peak
  * RSS in KiB (-1 on failure) and the message / object count it printed. */
 static long parse_many_measured(const char *item, long count, size_t max_objects, char *msg,
                                 size_t msg_size, long *objects, double *seconds)

@@ -31,12 +31,12 @@
 #include <time.h>
 
 #include "check.h"
-#include "image.h"
+#include "support/image.h"
 #include "integrator.h"
 #include "library_path.h"
 #include "parser.h"
 #include "scene.h"
-#include "tiles.h"
+#include "support/tiles.h"
 
 #ifndef LP_SOURCE_DIR
 #error "LP_SOURCE_DIR must name the source tree"

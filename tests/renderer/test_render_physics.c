@@ -55,8 +55,8 @@
 #include "integrator.h"
 #include "parser.h"
 #include "scene.h"
-#include "spectrum.h"
-#include "tiles.h"
+#include "support/colorimetry.h"
+#include "support/tiles.h"
 
 #define PI 3.14159265358979323846
 

@@ -1,4 +1,4 @@
-/* test_spectrum.c -- the colorimetry of the spectral modes (spectrum.h).
+/* test_spectrum.c -- the colorimetry of the spectral modes (emitter.h, support/colorimetry.h).
  *
  * Expected values come from published tables and standards, written here:
  *   - CIE 1931 2-degree observer, 5 nm abridged table (CIE 15:2004 Table
@@ -33,10 +33,10 @@
 #include <stdio.h>
 
 #include "check.h"
+#include "emitter.h"
 #include "integrator.h"
 #include "parser.h"
 #include "scene.h"
-#include "spectrum.h"
 
 static rs_color rgb(double r, double g, double b)
 {
@@ -50,7 +50,7 @@ static rs_spectrum spec_rgb(double r, double g, double b)
     return s;
 }
 
-/* The estimator of spectrum.h with N midpoint-stratified wavelengths. */
+/* The estimator of emitter.h with N midpoint-stratified wavelengths. */
 static void estimate_xyz(const rs_spectrum *s, int n, double xyz[3])
 {
     double norm = rs_spectrum_norm(s);
@@ -566,7 +566,7 @@ static void test_lines(void)
     }
 }
 
-/* RS_RGB_LAMBDA is what spectrum.h says: the first moment of each
+/* RS_RGB_LAMBDA is what colorimetry.h says: the first moment of each
  * channel's D65-weighted response (to the 0.1 nm it is rounded to). */
 static void test_rgb_lambda(void)
 {

@@ -18,10 +18,10 @@
 #include <sys/types.h>
 #include <unistd.h>
 
-#include "image.h"
+#include "support/image.h"
 #include "lensprim.h"
 #include "plot.h"
-#include "spectrum.h"
+#include "support/colorimetry.h"
 
 #define EXIT_USAGE 2
 #define PI 3.14159265358979323846

@@ -1450,7 +1450,7 @@ static void test_edges(void)
 /* ------------------------------------------------------------------ */
 
 /* Flat plate t = 1e-3 mm, n = 1.5, D = 10, depth 40, s and p at 0, 30,
- * 60 and 80 degrees (as tests/test_plate.c for t = 10): intensities
+ * 60 and 80 degrees (as tests/lensprim/test_plate.c for t = 10): intensities
  * R, (1-R)^2 R^(2k) (through), (1-R)^2 R^(2k-1) (back), relative
  * max(1e-12, depth 1e-13); optical path step between successive rays on
  * one side 2 n t / cos r, relative 1e-9 (op ~ 1e-3 mm, each hit distance

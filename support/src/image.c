@@ -18,8 +18,8 @@
 
 #include <png.h>
 
-#include "image.h"
-#include "spectrum.h"
+#include "support/image.h"
+#include "support/colorimetry.h"
 
 #if defined(__GNUC__)
 __attribute__((format(printf, 3, 4)))

@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "plot.h"
-#include "spectrum.h"
+#include "support/colorimetry.h"
 
 /* ---- The font ------------------------------------------------------------
  * 5x7 glyphs, one byte per row, top row first, bit 4 the leftmost column.

@@ -1,7 +1,7 @@
 /* tiles.c -- the tile thread pool (see tiles.h). */
 #define _POSIX_C_SOURCE 200809L
 
-#include "tiles.h"
+#include "support/tiles.h"
 
 #include <errno.h>
 #include <pthread.h>

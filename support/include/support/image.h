@@ -1,5 +1,5 @@
 /* image.h -- float RGB images, their files (PNG, PFM) and the metrics that
- * compare them (renderer-internal).
+ * compare them (support floor).
  *
  * An rs_image holds linear RGB as floats, 3 per pixel, row 0 at the top:
  * pixel (x, y) is rgb[3 * ((size_t)y * width + x) + c], c = 0, 1, 2.

@@ -52,8 +52,8 @@
 
 #include "camera.h"
 #include "check.h"
-#include "image.h"
 #include "library_path.h"
+#include "support/image.h"
 #include "parser.h"
 #include "scene.h"
 #include "translate.h"

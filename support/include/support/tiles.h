@@ -1,5 +1,5 @@
 /* tiles.h -- render an image in square tiles on a small thread pool
- * (renderer-internal).
+ * (support floor: the thread pool of every program).
  *
  * The image is cut into tiles of tile_size x tile_size pixels (smaller at
  * the right and bottom edges), numbered row by row from the top-left.

@@ -35,7 +35,7 @@ typedef struct tp_opts {
     long fsize_limit;
     /* non-zero: run the program through LP_BIN_DIR/measure_child, which
      * reports the program's own peak resident size in peak_kb (see
-     * tests/tools/measure_child.c: a child forked from the test would
+     * tests/common/measure_child.c: a child forked from the test would
      * count the test's memory, which under valgrind or a sanitizer is the
      * tool's). */
     int measure_memory;

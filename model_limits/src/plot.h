@@ -17,7 +17,7 @@
 
 #include <stddef.h>
 
-#include "image.h"
+#include "support/image.h"
 
 typedef enum pl_dash {
     PL_SOLID = 0,

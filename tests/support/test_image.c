@@ -39,8 +39,8 @@
 #include <png.h>
 
 #include "check.h"
-#include "image.h"
-#include "spectrum.h"
+#include "support/image.h"
+#include "support/colorimetry.h"
 #include "test_files.h"
 
 static char tmpdir[1024];

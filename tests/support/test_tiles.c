@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "check.h"
-#include "tiles.h"
+#include "support/tiles.h"
 
 typedef struct run_state {
     int width, height, tile;

@@ -1,6 +1,6 @@
-/* spectrum.c -- colour-matching functions, D65, Smits' RGB-to-spectrum
- * conversion, black bodies, spectral lines and linear sRGB (see
- * spectrum.h for the method and the estimator).
+/* colorimetry.c -- colour-matching functions, D65, Smits' RGB-to-spectrum
+ * conversion, black bodies and linear sRGB (see colorimetry.h; the
+ * emitters' spectra are in renderer/src/emitter.c).
  *
  * Data tables (facts, transcribed and checked as stated; the test suite
  * re-checks the published checksums):
@@ -36,7 +36,7 @@
  *   of h, c and k. */
 #include <math.h>
 
-#include "spectrum.h"
+#include "support/colorimetry.h"
 
 #define COUNT(a) (sizeof (a) / sizeof (a)[0])
 
@@ -553,7 +553,7 @@ static const double d65_table[] = {
 #define SMITS_BINS 10
 
 /* The published white spectrum is 1.0000 1.0000 0.9999 0.9993 0.9992
- * 0.9998 1.0000 1.0000 1.0000 1.0000; it is used as exactly 1 (spectrum.h).
+ * 0.9998 1.0000 1.0000 1.0000 1.0000; it is used as exactly 1 (colorimetry.h).
  * Rows in the order of the enum below. */
 enum { SM_CYAN, SM_MAGENTA, SM_YELLOW, SM_RED, SM_GREEN, SM_BLUE };
 
@@ -569,7 +569,7 @@ static const double smits_basis[6][SMITS_BINS] = {
 /* ---- Linear sRGB <-> XYZ ------------------------------------------------
  * Computed in exact rational arithmetic from the IEC 61966-2-1 primaries
  * R (0.64, 0.33), G (0.30, 0.60), B (0.15, 0.06) and the D65 white point
- * (0.3127, 0.3290), then rounded to double (spectrum.h). */
+ * (0.3127, 0.3290), then rounded to double (colorimetry.h). */
 static const double srgb_to_xyz[3][3] = {
     {0.41239079926595951, 0.35758433938387796, 0.18048078840183429},
     {0.21263900587151036, 0.71516867876775592, 0.072192315360733714},
@@ -717,90 +717,6 @@ double rs_planck(double temperature_k, double lambda_nm)
     /* expm1 -> +inf for x > ~709: the radiance underflows to 0. */
     return 2.0 * PLANCK_H * LIGHT_C * LIGHT_C / (lm * lm * lm * lm * lm)
            / expm1(x) * 1e-9;
-}
-
-/* Integral over 380-780 nm of planck(T) ȳ: Simpson's rule on each 1 nm
- * interval (ȳ is linear there; the black body is smooth). */
-static double blackbody_ybar_integral(double temperature_k)
-{
-    double sum = 0.0, cmf[3];
-    int a = (int)RS_LAMBDA_MIN, b = (int)RS_LAMBDA_MAX;
-    double prev;
-
-    rs_cmf(a, cmf);
-    prev = rs_planck(temperature_k, a) * cmf[1];
-    for (int n = a; n < b; n++) {
-        double mid, next;
-        rs_cmf(n + 0.5, cmf);
-        mid = rs_planck(temperature_k, n + 0.5) * cmf[1];
-        rs_cmf(n + 1, cmf);
-        next = rs_planck(temperature_k, n + 1) * cmf[1];
-        sum += (prev + 4.0 * mid + next) / 6.0;
-        prev = next;
-    }
-    return sum;
-}
-
-/* ---- Emitters ---------------------------------------------------------- */
-
-double rs_spectrum_line_power(const rs_spectrum *s)
-{
-    double cmf[3], ybar;
-
-    if (s->type != RS_SPECTRUM_LINE)
-        return 0.0;
-    if (!(s->line_nm >= RS_CMF_MIN_NM && s->line_nm <= RS_CMF_MAX_NM))
-        return 0.0;
-    rs_cmf(s->line_nm, cmf);
-    ybar = cmf[1] > RS_LINE_YBAR_MIN ? cmf[1] : RS_LINE_YBAR_MIN;
-    return rs_luminance(s->rgb) / ybar;
-}
-
-void rs_spectrum_line_xyz(const rs_spectrum *s, double xyz[3])
-{
-    double p = rs_spectrum_line_power(s);
-
-    rs_cmf(s->type == RS_SPECTRUM_LINE ? s->line_nm : -1.0, xyz);
-    for (int k = 0; k < 3; k++)
-        xyz[k] *= p;
-}
-
-double rs_spectrum_norm(const rs_spectrum *s)
-{
-    switch (s->type) {
-    case RS_SPECTRUM_RGB:
-        return 1.0 / D65_YBAR_INTEGRAL;
-    case RS_SPECTRUM_BLACKBODY: {
-        double integral = blackbody_ybar_integral(s->temperature_k);
-        double norm;
-        if (!(integral > 0.0))
-            return 0.0;
-        norm = rs_luminance(s->rgb) / integral;
-        return isfinite(norm) ? norm : 0.0;
-    }
-    case RS_SPECTRUM_LINE:
-        return rs_spectrum_line_power(s);
-    }
-    return 0.0;
-}
-
-double rs_spectrum_emission_norm(const rs_spectrum *s, double norm,
-                                 double lambda_nm)
-{
-    switch (s->type) {
-    case RS_SPECTRUM_RGB:
-        return norm * rs_d65(lambda_nm) * rs_emission_shape(s->rgb, lambda_nm);
-    case RS_SPECTRUM_BLACKBODY:
-        return norm * rs_planck(s->temperature_k, lambda_nm);
-    case RS_SPECTRUM_LINE:
-        return 0.0;
-    }
-    return 0.0;
-}
-
-double rs_spectrum_emission(const rs_spectrum *s, double lambda_nm)
-{
-    return rs_spectrum_emission_norm(s, rs_spectrum_norm(s), lambda_nm);
 }
 
 /* ---- XYZ and sRGB ------------------------------------------------------ */

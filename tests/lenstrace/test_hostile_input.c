@@ -18,8 +18,8 @@
  *     lines, 10^5 glasses, text beyond the 64 MiB limit.  Parse errors name
  *     the line ("AGF text, line N: ...").
  *
- * lenstrace_args.c is compiled into this test (it belongs to the lenstrace
- * executable, not to the library). */
+ * The parser is lenstrace's own small library (lenstrace_args), linked
+ * into this test as into the program and its fuzz target. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <math.h>
@@ -34,7 +34,7 @@
 #include "subprocess.h"
 #include "test_files.h"
 
-#include "../lensprim/tools/lenstrace_args.c"
+#include "lenstrace_args.h"
 
 #ifndef LP_BIN_DIR
 #error "LP_BIN_DIR must name the directory of the built programs"
@@ -42,14 +42,14 @@
 
 static const char *const LENSTRACE = LP_BIN_DIR "/lenstrace";
 
-/* tests/regressions/<target>, next to this file. */
+/* tests/regressions/<target>, beside this file's folder. */
 static void regression_dir(char *out, size_t n, const char *target)
 {
     const char *slash = strrchr(__FILE__, '/');
     if (slash)
-        snprintf(out, n, "%.*s/regressions/%s", (int)(slash - __FILE__), __FILE__, target);
+        snprintf(out, n, "%.*s/../regressions/%s", (int)(slash - __FILE__), __FILE__, target);
     else
-        snprintf(out, n, "regressions/%s", target);
+        snprintf(out, n, "../regressions/%s", target);
 }
 
 static uint64_t rng_state = 0x9E3779B97F4A7C15ull;
