@@ -79,25 +79,35 @@ extern "C" {
 #  define LP_API
 #endif
 
+/* The version of this header (the build reads it from here).  A program
+ * can compare it with the library it runs with, lp_version_number(). */
 #define LP_VERSION_MAJOR 0
 #define LP_VERSION_MINOR 1
 #define LP_VERSION_PATCH 0
+#define LP_VERSION_NUMBER \
+    (LP_VERSION_MAJOR * 10000 + LP_VERSION_MINOR * 100 + LP_VERSION_PATCH)
+
+/* The library's version as MAJOR * 10000 + MINOR * 100 + PATCH (so 0.1.0
+ * is 100), and as the string "MAJOR.MINOR.PATCH" (static, never NULL). */
+LP_API int lp_version_number(void);
+LP_API const char *lp_version_string(void);
 
 /* ------------------------------------------------------------------ */
 /* Status                                                              */
 /* ------------------------------------------------------------------ */
 
+/* The values are fixed: a program may store or print them. */
 typedef enum lp_status {
     LP_OK = 0,
-    LP_ERROR_INVALID_ARGUMENT, /* NULL where not allowed, NaN, zero vector, ... */
-    LP_ERROR_INVALID_LENS,     /* a lens shape that cannot exist */
-    LP_ERROR_INVALID_GLASS,    /* a glass description that cannot be used */
-    LP_ERROR_UNKNOWN_GLASS,    /* no glass of that name in the catalog */
-    LP_ERROR_UNSUPPORTED,      /* e.g. an AGF dispersion formula lensprim cannot evaluate */
-    LP_ERROR_PARSE,            /* malformed catalog text */
-    LP_ERROR_IO,               /* a file could not be read */
-    LP_ERROR_NO_MEMORY,
-    LP_ERROR_RANGE             /* an index out of range */
+    LP_ERROR_INVALID_ARGUMENT = 1, /* NULL where not allowed, NaN, zero vector, ... */
+    LP_ERROR_INVALID_LENS = 2,     /* a lens shape that cannot exist */
+    LP_ERROR_INVALID_GLASS = 3,    /* a glass description that cannot be used */
+    LP_ERROR_UNKNOWN_GLASS = 4,    /* no glass of that name in the catalog */
+    LP_ERROR_UNSUPPORTED = 5,      /* e.g. an AGF dispersion formula lensprim cannot evaluate */
+    LP_ERROR_PARSE = 6,            /* malformed catalog text */
+    LP_ERROR_IO = 7,               /* a file could not be read */
+    LP_ERROR_NO_MEMORY = 8,
+    LP_ERROR_RANGE = 9             /* an index out of range */
 } lp_status;
 
 /* A status and a message.  message is always NUL-terminated. */
@@ -562,7 +572,8 @@ LP_API lp_status lp_cone_compute(const lp_lens *lens, lp_vec3 point,
  * offset from the ray through the front vertex: at azimuth phi (frame as
  * above, the apex the front vertex) the largest offset rho_K such that
  * every ray at a smaller offset on that azimuth is rim-free, found as
- * theta_K is (mm). */
+ * theta_K is (mm).  Every rho_K is 0 when the ray through the front vertex
+ * is not rim-free itself (a rim-free region away from it is not sought). */
 typedef struct lp_beam_region {
     lp_cone_frame frame;
     int depth;

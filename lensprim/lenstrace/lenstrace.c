@@ -1,8 +1,9 @@
-/* lenstrace.c -- one ray through one lens, as JSON Lines.
+/* lenstrace.c -- rays through one lens, as JSON Lines.
  *
  * Parses the command line (lenstrace_args.c), builds the lens, traces the
- * ray forward (from the light) or backward (from the eye), and prints one
- * JSON line per outgoing ray and a summary line.  All output is built in
+ * ray (--ray) or each ray of a file (--rays) forward (from the light) or
+ * backward (from the eye), and prints one JSON line per outgoing ray and a
+ * summary line per input ray.  All output is built in
  * memory first: on any error stdout stays empty and stderr gets exactly
  * one line "lenstrace: <message>", exit status 2. */
 #include <errno.h>
@@ -15,19 +16,20 @@
 
 #include "lensprim.h"
 #include "lenstrace_args.h"
+#include "support/cli.h"
 
 #define EXIT_BAD 2
 
 /* Split in parts: C11 compilers need only support 4095-char literals. */
 static const char *const usage_text[] = {
-"usage: lenstrace --lens SPEC --ray SPEC [--depth N]\n"
+"usage: lenstrace --lens SPEC (--ray SPEC | --rays FILE) [--depth N]\n"
 "                 [--mode polarized|fresnel|schlick] [--medium N]\n"
 "                 [--backward] [--catalog FILE.agf]...\n"
 "       lenstrace --lens SPEC --cone \"x,y,z\" [--depth N] [--azimuths K]\n"
 "                 [--lambda NM] [--medium N] [--catalog FILE.agf]...\n"
 "       lenstrace --help | --version\n"
 "\n"
-"Trace one ray through one lens and print every outgoing ray as JSON Lines.\n"
+"Trace rays through one lens and print every outgoing ray as JSON Lines.\n"
 "Options take their value as \"--opt VALUE\" or \"--opt=VALUE\".\n"
 "Lengths are in millimetres, wavelengths in nanometres, phases in radians.\n"
 "\n"
@@ -47,13 +49,22 @@ static const char *const usage_text[] = {
 "                     \"o=0,3,-10 d=0,0,1 lambda=587.56 vp=1,0,0 I=1 ch=7\"\n"
 "                   o=x,y,z   origin                               required\n"
 "                   d=x,y,z   direction (normalized)               required\n"
-"                   lambda=NM vacuum wavelength (default 587.56); glass\n"
-"                             data are for air, so the ray is traced at\n"
-"                             lambda/n_air (standard air, Edlen 1966)\n"
+"                   lambda=NM wavelength in standard air, as glass catalogs\n"
+"                             and line tables give it (default 587.56, the\n"
+"                             d line: n is the catalog's n_d exactly)\n"
+"                   lambda_vac=NM  a vacuum wavelength instead, traced at\n"
+"                             lambda_vac/n_air (standard air, Edlen 1966)\n"
 "                   vp=x,y,z  field direction, made perpendicular to d,\n"
 "                             or vp=unpolarized (the default)\n"
 "                   I=..      intensity (default 1)\n"
 "                   ch=..     source id, an unsigned integer (default 0)\n"
+"                   The origin must lie outside the glass (in the\n"
+"                   surrounding medium); a ray born inside is refused.\n"
+"  --rays FILE      one --ray SPEC per line instead of --ray (- reads\n"
+"                   standard input; blank lines and lines starting with #\n"
+"                   are skipped).  Each ray's lines and its summary end\n"
+"                   with \"ray\":K, K = 0, 1, ... in the order of the file;\n"
+"                   an error names FILE:LINE and nothing is printed.\n"
 "  --depth N        tree depth dT, 1..64 (default 5)\n"
 "  --mode M         polarized (Fresnel on s and p with vectors and phases,\n"
 "                   the default), fresnel ((Rs+Rp)/2 per interface) or\n"
@@ -80,8 +91,10 @@ static const char *const usage_text[] = {
 "  kind     reflect (leaves on the side the light came from) or transmit\n"
 "  vp       unit field direction; the field is sqrt(I)*vp*exp(i*Phi) with\n"
 "           Phi = 2*pi*op/lambda - pi*kphi + phase\n"
-"  op       optical path inside the lens, mm: n_air * sum of n*s with the\n"
-"           air-relative glass index n (the absolute optical path)\n"
+"  lambda   the wavelength in standard air (also with lambda_vac=)\n"
+"  op       optical path inside the lens relative to air, mm: sum of n*s\n"
+"           with the air-relative glass index n (times the index of air it\n"
+"           is the absolute optical path)\n"
 "  phase    extra phase beyond 2*pi*op/lambda - pi*kphi (non-zero only\n"
 "           after total internal reflection)\n"
 "  surface  cap the ray leaves from (front or back); part 0, or 1 for the\n"
@@ -233,17 +246,17 @@ static const char *surface_name(int s)
 /* One ray line.  query: NULL for a forward trace.  half: -1 when the ray
  * is polarized (no "half" key). */
 static void put_ray(outbuf *b, const lp_out_ray *r, const lp_query *query,
-                    int half, double lambda_vac, double n_air)
+                    int half, double lambda_nm, long index)
 {
     ob_printf(b, "{\"depth\":%d,\"kind\":\"%s\"", r->depth,
               r->kind == LP_KIND_REFLECT ? "reflect" : "transmit");
     ob_vec(b, "o", r->ray.origin);
     ob_vec(b, "d", r->ray.dir);
-    ob_num(b, "lambda", lambda_vac);
+    ob_num(b, "lambda", lambda_nm);
     ob_num(b, "I", r->ray.intensity);
     ob_vec(b, "vp", r->ray.vp);
     ob_printf(b, ",\"kphi\":%d", r->ray.kphi);
-    ob_num(b, "op", r->ray.op * n_air);
+    ob_num(b, "op", r->ray.op);
     ob_num(b, "phase", r->ray.phase);
     ob_printf(b, ",\"ch\":%" PRIu64, r->ray.ch);
     if (query) {
@@ -254,6 +267,8 @@ static void put_ray(outbuf *b, const lp_out_ray *r, const lp_query *query,
               surface_name(r->surface), r->part, r->path);
     if (half >= 0)
         ob_printf(b, ",\"half\":%d", half);
+    if (index >= 0)
+        ob_printf(b, ",\"ray\":%ld", index);
     ob_printf(b, "}\n");
 }
 
@@ -273,7 +288,7 @@ static void add_totals(totals *t, const lp_result *r)
     t->warnings |= r->warnings;
 }
 
-static void put_summary(outbuf *b, const totals *t)
+static void put_summary(outbuf *b, const totals *t, long index)
 {
     char in[40];
     if (!isfinite(t->in) && !b->bad_key)
@@ -295,7 +310,10 @@ static void put_summary(outbuf *b, const totals *t)
         if (t->warnings & LP_WARN_LEAK)
             ob_printf(b, "%s\"leak\"", sep);
     }
-    ob_printf(b, "]}}\n");
+    if (index >= 0)
+        ob_printf(b, "]},\"ray\":%ld}\n", index);
+    else
+        ob_printf(b, "]}}\n");
 }
 
 /* ------------------------------------------------------------------ */
@@ -306,13 +324,7 @@ static void put_summary(outbuf *b, const totals *t)
  * user text or library messages become '?'). */
 static void say(const char *prefix, const char *msg)
 {
-    char line[640];
-    snprintf(line, sizeof line, "lenstrace: %s%s", prefix ? prefix : "",
-             msg);
-    for (char *c = line; *c; c++)
-        if ((unsigned char)*c < 0x20 || *c == 0x7f)
-            *c = '?';
-    fprintf(stderr, "%s\n", line);
+    sp_say("lenstrace", "%s%s", prefix ? prefix : "", msg);
 }
 
 static const char *lib_message(const lp_error *err, lp_status st)
@@ -326,13 +338,15 @@ static const char *lib_message(const lp_error *err, lp_status st)
 
 typedef struct run {
     const lt_args *a;
+    const lt_ray_spec *ray; /* the ray being traced */
+    long index;             /* its index in --rays, -1 for --ray */
+    char where[256];        /* "--ray" or "--rays: FILE:LINE" */
+    unsigned warnings;      /* of every ray traced */
     const lp_lens *lens;
     lp_trace_args targs;
     outbuf out;
     totals sum;
-    double n_air;      /* standard air at the vacuum wavelength given */
-    double lambda_air; /* the wavelength the library traces at */
-    char msg[512];
+    char msg[768];
 } run;
 
 /* The field of half h (0 or 1) of unpolarized light along the unit d. */
@@ -344,7 +358,7 @@ static lp_vec3 half_vp(lp_vec3 d, int h)
 
 static int run_forward(run *r)
 {
-    const lt_ray_spec *ray = &r->a->ray;
+    const lt_ray_spec *ray = r->ray;
     int halves = ray->unpolarized ? 2 : 1;
     lp_result res;
     lp_error err;
@@ -357,7 +371,7 @@ static int run_forward(run *r)
         memset(&in, 0, sizeof in);
         in.origin = ray->o;
         in.dir = ray->d;
-        in.lambda_nm = r->lambda_air;
+        in.lambda_nm = ray->lambda_nm;
         in.intensity = ray->intensity / halves;
         in.vp = ray->unpolarized ? half_vp(ray->d, h) : ray->vp;
         in.ch = ray->ch;
@@ -370,7 +384,7 @@ static int run_forward(run *r)
         }
         for (size_t i = 0; i < res.count; i++)
             put_ray(&r->out, &res.rays[i], NULL, ray->unpolarized ? h : -1,
-                    ray->lambda_nm, r->n_air);
+                    ray->lambda_nm, r->index);
         add_totals(&r->sum, &res);
     }
     lp_result_release(&res);
@@ -379,7 +393,7 @@ static int run_forward(run *r)
 
 static int run_backward(run *r)
 {
-    const lt_ray_spec *ray = &r->a->ray;
+    const lt_ray_spec *ray = r->ray;
     int halves = ray->unpolarized ? 2 : 1;
     lp_backward *bw = NULL;
     lp_result res;
@@ -396,7 +410,7 @@ static int run_backward(run *r)
     memset(&err, 0, sizeof err);
     st = lp_backward_create(&bw, &err);
     if (st == LP_OK)
-        st = lp_backward_build(bw, r->lens, ray->o, ray->d, r->lambda_air,
+        st = lp_backward_build(bw, r->lens, ray->o, ray->d, ray->lambda_nm,
                                &r->targs, &err);
     if (st != LP_OK) {
         snprintf(r->msg, sizeof r->msg, "%s", lib_message(&err, st));
@@ -414,7 +428,7 @@ static int run_backward(run *r)
             memset(&b, 0, sizeof b);
             b.origin = qs[q].origin;
             b.dir = back;
-            b.lambda_nm = r->lambda_air;
+            b.lambda_nm = ray->lambda_nm;
             b.intensity = ray->intensity / halves;
             b.ch = ray->ch;
             if (ray->unpolarized)
@@ -456,7 +470,8 @@ static int run_backward(run *r)
     if (ok) {
         for (size_t i = 0; i < res.count; i++)
             put_ray(&r->out, &res.rays[i], &qs[qidx[i]],
-                    ray->unpolarized ? half[i] : -1, ray->lambda_nm, r->n_air);
+                    ray->unpolarized ? half[i] : -1, ray->lambda_nm,
+                    r->index);
         add_totals(&r->sum, &res);
     }
     free(qidx);
@@ -512,6 +527,109 @@ static int run_cone(run *r)
     ob_printf(&r->out, "}}\n");
     free(theta);
     return 1;
+}
+
+/* Trace r->ray: its ray lines and its summary line into r->out.  0 and
+ * r->msg on error. */
+static int trace_one(run *r)
+{
+    static const totals zero;
+    const lp_vec3 o = r->ray->o;
+    int ok;
+
+    if (lp_lens_contains(r->lens, o)) {
+        /* The library's chain starts with the light arriving from the
+           surrounding medium; a ray born in the glass would have no first
+           interface. */
+        snprintf(r->msg, sizeof r->msg,
+                 "%s: the origin %.17g,%.17g,%.17g lies inside the glass "
+                 "(rays must start in the surrounding medium)",
+                 r->where, o.x, o.y, o.z);
+        return 0;
+    }
+    r->sum = zero;
+    ok = r->a->backward ? run_backward(r) : run_forward(r);
+    if (ok) {
+        put_summary(&r->out, &r->sum, r->index);
+        r->warnings |= r->sum.warnings;
+    }
+    return ok;
+}
+
+/* The longest line of a --rays file, newline included. */
+#define RAYS_LINE_MAX 4096
+
+/* --rays FILE: one ray spec per line (blank lines and lines starting with
+ * '#' are skipped), traced in order with index 0, 1, ...  0 and r->msg on
+ * error (nothing is kept of the rays before it). */
+static int trace_file(run *r)
+{
+    const char *name = r->a->rays_file;
+    int is_stdin = strcmp(name, "-") == 0;
+    FILE *f = is_stdin ? stdin : fopen(name, "r");
+    const char *shown = is_stdin ? "<stdin>" : name;
+    char line[RAYS_LINE_MAX + 1];
+    lt_args *scratch = NULL;
+    lt_ray_spec ray;
+    long lineno = 0;
+    int ok = 1;
+
+    r->index = 0;
+    if (!f) {
+        snprintf(r->msg, sizeof r->msg, "--rays: cannot open %s: %s", name,
+                 strerror(errno));
+        return 0;
+    }
+    scratch = malloc(sizeof *scratch);
+    if (!scratch) {
+        snprintf(r->msg, sizeof r->msg, "out of memory");
+        ok = 0;
+    }
+    while (ok && fgets(line, sizeof line, f)) {
+        size_t len = strlen(line);
+        const char *p = line;
+        lineno++;
+        if (len > 0 && line[len - 1] == '\n')
+            line[--len] = '\0';
+        else if (!feof(f)) {
+            snprintf(r->msg, sizeof r->msg, "--rays: %.200s:%ld: line longer "
+                     "than %d characters", shown, lineno, RAYS_LINE_MAX - 1);
+            ok = 0;
+            break;
+        }
+        if (len > 0 && line[len - 1] == '\r')
+            line[--len] = '\0';
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (*p == '\0' || *p == '#')
+            continue;
+        lt_args_init(scratch);
+        if (lt_parse_ray_spec(scratch, p, &ray)) {
+            snprintf(r->msg, sizeof r->msg, "--rays: %.200s:%ld: %s", shown,
+                     lineno, scratch->error);
+            ok = 0;
+            break;
+        }
+        snprintf(r->where, sizeof r->where, "--rays: %.200s:%ld", shown,
+                 lineno);
+        r->ray = &ray;
+        ok = trace_one(r);
+        r->index++;
+    }
+    if (ok && ferror(f)) {
+        snprintf(r->msg, sizeof r->msg, "--rays: cannot read %s: %s", name,
+                 strerror(errno));
+        ok = 0;
+    }
+    if (ok && r->index == 0) {
+        snprintf(r->msg, sizeof r->msg, "--rays: %s holds no ray spec",
+                 shown);
+        ok = 0;
+    }
+    if (!is_stdin)
+        fclose(f);
+    free(scratch);
+    return ok;
 }
 
 /* Build the glass of the lens; 0 and r->msg on error. */
@@ -609,13 +727,17 @@ static int build_and_trace(run *r)
     lp_trace_args_init(&r->targs);
     r->targs.mode = a->mode;
     r->targs.max_depth = a->depth;
-    if (a->cone)
+    if (a->cone) {
         ok = run_cone(r);
-    else
-        ok = a->backward ? run_backward(r) : run_forward(r);
+    } else if (a->rays_file) {
+        ok = trace_file(r);
+    } else {
+        r->ray = &a->ray;
+        r->index = -1;
+        snprintf(r->where, sizeof r->where, "--ray");
+        ok = trace_one(r);
+    }
     if (ok) {
-        if (!a->cone)
-            put_summary(&r->out, &r->sum);
         if (r->out.oom) {
             snprintf(r->msg, sizeof r->msg, "out of memory");
             ok = 0;
@@ -663,27 +785,23 @@ int main(int argc, char **argv)
 
     memset(&r, 0, sizeof r);
     r.a = a;
-    /* The contract's wavelengths are in vacuum; the library works in
-     * standard air with air-relative indices (as glass catalogs do).  Trace
-     * at the air wavelength and report the absolute optical path, so that
-     * 2*pi*op/lambda stays exact with the vacuum lambda printed. */
-    r.n_air = a->cone ? 1.0 : lp_air_index(a->ray.lambda_nm); /* --cone: air */
-    r.lambda_air = a->ray.lambda_nm / r.n_air;
-    if (!isfinite(r.n_air)) {
-        say(NULL, "lambda must be a vacuum wavelength of at least 160 nm");
-        status = EXIT_BAD;
-    } else if (!build_and_trace(&r)) {
+    if (!build_and_trace(&r)) {
         say(NULL, r.msg);
         status = EXIT_BAD;
     } else {
-        if (r.sum.warnings & LP_WARN_EXTRAPOLATED) {
+        if (r.warnings & LP_WARN_EXTRAPOLATED) {
             char m[160];
-            snprintf(m, sizeof m, "lambda %.17g nm lies outside the glass's "
-                     "data range; its index was extrapolated",
-                     a->ray.lambda_nm);
+            if (a->rays_file)
+                snprintf(m, sizeof m, "a wavelength lies outside the glass's "
+                         "data range; its index was extrapolated (see the "
+                         "summaries' warnings)");
+            else
+                snprintf(m, sizeof m, "lambda %.17g nm lies outside the "
+                         "glass's data range; its index was extrapolated",
+                         a->ray.lambda_nm);
             say("warning: ", m);
         }
-        if (r.sum.warnings & LP_WARN_LEAK)
+        if (r.warnings & LP_WARN_LEAK)
             say("warning: ", "an internal ray found no surface (numerical); "
                 "its energy was counted as absorbed at the rim");
         if (fwrite(r.out.p, 1, r.out.len, stdout) != r.out.len ||

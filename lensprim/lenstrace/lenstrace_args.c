@@ -323,8 +323,8 @@ const char *lt_parse_lens_spec(lt_args *args, const char *spec,
 /* --ray                                                               */
 /* ------------------------------------------------------------------ */
 
-enum { RK_O, RK_D, RK_LAMBDA, RK_VP, RK_I, RK_CH, RK_COUNT };
-static const char *const ray_keys[RK_COUNT] = {"o", "d", "lambda",
+enum { RK_O, RK_D, RK_LAMBDA, RK_LAMBDA_VAC, RK_VP, RK_I, RK_CH, RK_COUNT };
+static const char *const ray_keys[RK_COUNT] = {"o", "d", "lambda", "lambda_vac",
                                                "vp", "I", "ch"};
 
 static const char *parse_ch(lt_args *args, const char *s, uint64_t *out)
@@ -391,7 +391,7 @@ const char *lt_parse_ray_spec(lt_args *args, const char *spec,
                 key = k;
         if (key < 0)
             return fail(args, "--ray: unknown key '%s' (keys: o, d, lambda, "
-                              "vp, I, ch)", item);
+                              "lambda_vac, vp, I, ch)", item);
         if (seen[key])
             return fail(args, "--ray: duplicate key '%s'", item);
         seen[key] = 1;
@@ -406,6 +406,10 @@ const char *lt_parse_ray_spec(lt_args *args, const char *spec,
             break;
         case RK_LAMBDA:
             if (parse_positive(args, "--ray", "lambda", val, &r.lambda_nm))
+                return args->error;
+            break;
+        case RK_LAMBDA_VAC:
+            if (parse_positive(args, "--ray", "lambda_vac", val, &r.lambda_vac_nm))
                 return args->error;
             break;
         case RK_VP:
@@ -437,6 +441,21 @@ const char *lt_parse_ray_spec(lt_args *args, const char *spec,
         return fail(args, "--ray: missing key 'o' (the origin x,y,z)");
     if (!seen[RK_D])
         return fail(args, "--ray: missing key 'd' (the direction x,y,z)");
+    if (seen[RK_LAMBDA] && seen[RK_LAMBDA_VAC])
+        return fail(args, "--ray: give lambda (in air) or lambda_vac (in "
+                          "vacuum), not both");
+    if (seen[RK_LAMBDA_VAC]) {
+        double n_air = lp_air_index(r.lambda_vac_nm);
+        if (!isfinite(n_air))
+            return fail(args, "--ray: lambda_vac must be at least %g nm "
+                              "(Edlen's standard air), got '%.17g'",
+                        LT_LAMBDA_MIN_NM, r.lambda_vac_nm);
+        r.lambda_nm = r.lambda_vac_nm / n_air;
+    } else if (!(r.lambda_nm >= LT_LAMBDA_MIN_NM)) {
+        return fail(args, "--ray: lambda must be at least %g nm (where "
+                          "standard air is defined), got '%.17g'",
+                    LT_LAMBDA_MIN_NM, r.lambda_nm);
+    }
     if (!normalize(r.d, &r.d))
         return fail(args, "--ray: d is the zero vector (a direction is "
                           "needed)");
@@ -469,7 +488,7 @@ void lt_args_init(lt_args *args)
 }
 
 enum {
-    OPT_LENS, OPT_RAY, OPT_DEPTH, OPT_MODE, OPT_MEDIUM, OPT_BACKWARD,
+    OPT_LENS, OPT_RAY, OPT_RAYS, OPT_DEPTH, OPT_MODE, OPT_MEDIUM, OPT_BACKWARD,
     OPT_CATALOG, OPT_HELP, OPT_VERSION, OPT_CONE, OPT_AZIMUTHS, OPT_LAMBDA,
     OPT_COUNT
 };
@@ -478,7 +497,7 @@ static const struct {
     const char *name;
     int takes_value;
 } options[OPT_COUNT] = {
-    {"lens", 1},     {"ray", 1},      {"depth", 1},
+    {"lens", 1},     {"ray", 1},      {"rays", 1},     {"depth", 1},
     {"mode", 1},     {"medium", 1},   {"backward", 0},
     {"catalog", 1},  {"help", 0},     {"version", 0},
     {"cone", 1},     {"azimuths", 1}, {"lambda", 1},
@@ -598,6 +617,12 @@ const char *lt_args_parse(lt_args *args, int argc, char **argv)
             if (lt_parse_ray_spec(args, value, &args->ray))
                 return args->error;
             break;
+        case OPT_RAYS:
+            if (*value == '\0')
+                return fail(args, "--rays: empty file name (use - for "
+                                  "standard input)");
+            args->rays_file = value;
+            break;
         case OPT_DEPTH:
             if (parse_depth(args, value))
                 return args->error;
@@ -639,7 +664,8 @@ const char *lt_args_parse(lt_args *args, int argc, char **argv)
             break;
         }
     }
-    if (seen[OPT_CONE] && (seen[OPT_RAY] || seen[OPT_BACKWARD] || seen[OPT_MODE]))
+    if (seen[OPT_CONE] && (seen[OPT_RAY] || seen[OPT_RAYS] || seen[OPT_BACKWARD] ||
+                           seen[OPT_MODE]))
         return fail(args, "--cone traces no ray: it takes no --ray, --backward "
                           "or --mode");
     if (!seen[OPT_CONE] && (seen[OPT_AZIMUTHS] || seen[OPT_LAMBDA]))
@@ -649,9 +675,11 @@ const char *lt_args_parse(lt_args *args, int argc, char **argv)
         return fail(args, "missing --lens (e.g. --lens "
                           "\"R1=25.8,R2=inf,t=5.3,D=25.4,glass=N-BK7\"; "
                           "try --help)");
-    if (!seen[OPT_RAY] && !seen[OPT_CONE])
+    if (seen[OPT_RAY] && seen[OPT_RAYS])
+        return fail(args, "give --ray or --rays, not both");
+    if (!seen[OPT_RAY] && !seen[OPT_RAYS] && !seen[OPT_CONE])
         return fail(args, "missing --ray (e.g. --ray \"o=0,3,-10 d=0,0,1 "
-                          "vp=1,0,0\"; try --help)");
+                          "vp=1,0,0\") or --rays FILE; try --help)");
     args->error[0] = '\0';
     return NULL;
 }

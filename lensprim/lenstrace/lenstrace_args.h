@@ -21,6 +21,9 @@
 #define LT_CATALOG_MAX 16     /* --catalog may be given this many times */
 #define LT_ERROR_MAX 384
 #define LT_AZIMUTHS_MAX 100000 /* --azimuths at most */
+/* The shortest wavelength accepted (air or vacuum), nm: where Edlen's
+ * standard air, lp_air_index, begins. */
+#define LT_LAMBDA_MIN_NM 160.0
 
 /* --lens "R1=..,R2=..,t=..,D=..,D2=..,glass=NAME|n=N" (or n=N as a key) */
 typedef struct lt_lens_spec {
@@ -33,11 +36,16 @@ typedef struct lt_lens_spec {
     char glass_name[LT_GLASS_NAME_MAX]; /* catalog name when !glass_constant */
 } lt_lens_spec;
 
-/* --ray "o=x,y,z d=x,y,z lambda=NM vp=x,y,z|unpolarized I=.. ch=.." */
+/* --ray "o=x,y,z d=x,y,z lambda=NM vp=x,y,z|unpolarized I=.. ch=.."
+ * (or lambda_vac=NM instead of lambda=NM) */
 typedef struct lt_ray_spec {
     lp_vec3 o;
     lp_vec3 d;            /* unit */
-    double lambda_nm;     /* finite > 0; default 587.56 */
+    double lambda_nm;     /* in standard air, finite > 0; default 587.56
+                             (the d line: glass catalogs' n_d exactly) */
+    double lambda_vac_nm; /* lambda_vac=, a vacuum wavelength (0: not
+                             given); lambda_nm is then lambda_vac_nm /
+                             lp_air_index(lambda_vac_nm) (Edlen 1966) */
     double intensity;     /* finite >= 0; default 1 */
     int unpolarized;      /* 1 when vp=unpolarized or vp omitted */
     lp_vec3 vp;           /* unit, perpendicular to d, when !unpolarized */
@@ -48,7 +56,10 @@ typedef struct lt_args {
     int help;             /* --help / -h: print usage, nothing else parsed */
     int version;          /* --version / -V */
     lt_lens_spec lens;
-    lt_ray_spec ray;
+    lt_ray_spec ray;      /* --ray, when rays_file is NULL */
+    const char *rays_file; /* --rays FILE ("-": standard input), points
+                              into argv; its lines are parsed by the
+                              program with lt_parse_ray_spec */
     int depth;            /* 1..LP_MAX_DEPTH, default 5 */
     lp_mode mode;         /* default LP_MODE_POLARIZED */
     double medium;        /* constant index, finite > 0, default 1 */

@@ -18,10 +18,11 @@
 #include <sys/types.h>
 #include <unistd.h>
 
-#include "support/image.h"
 #include "lensprim.h"
 #include "plot.h"
+#include "support/cli.h"
 #include "support/colorimetry.h"
+#include "support/image.h"
 
 #define EXIT_USAGE 2
 #define PI 3.14159265358979323846
@@ -519,26 +520,6 @@ static int out_close(outfile *o)
         return -1;
     }
     return 0;
-}
-
-static int mkdir_p(const char *dir)
-{
-    char buf[4096];
-    size_t n = strlen(dir);
-    if (n == 0 || n >= sizeof buf)
-        return -1;
-    memcpy(buf, dir, n + 1);
-    for (size_t i = 1; i <= n; i++) {
-        if (buf[i] == '/' || buf[i] == '\0') {
-            char c = buf[i];
-            buf[i] = '\0';
-            if (mkdir(buf, 0777) != 0 && errno != EEXIST)
-                return -1;
-            buf[i] = c;
-        }
-    }
-    struct stat st;
-    return stat(dir, &st) == 0 && S_ISDIR(st.st_mode) ? 0 : -1;
 }
 
 static void csv_num(FILE *f, const char *fmt, double v)
@@ -1207,10 +1188,12 @@ int main(int argc, char **argv)
             goto fail;
     }
 
-    if (mkdir_p(op.out)) {
-        fprintf(stderr, "model_limits: cannot create directory '%s': %s\n", op.out,
-                strerror(errno));
-        goto out;
+    {
+        char msg[4200];
+        if (sp_mkdir_p(op.out, msg, sizeof msg)) {
+            sp_say("model_limits", "%s", msg);
+            goto out;
+        }
     }
     if (write_angle_csv(op.out, sw) || write_depth_csv(op.out, ds) ||
         write_glass_csv(op.out, sw, ds, nd)) {

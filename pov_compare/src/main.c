@@ -23,6 +23,7 @@
 
 #include "camera.h"
 #include "compare.h"
+#include "support/cli.h"
 #include "support/image.h"
 #include "integrator.h"
 #include "library_path.h"
@@ -42,11 +43,13 @@
 #define PIXELS_MAX (64LL * 1024 * 1024)
 #define DEPTH_MAX 256
 #define WAVELENGTHS 16
+#define LIBRARY_PATHS_MAX 32
 
 static const char usage_text[] =
     "usage: pov_compare SCENE [--out DIR] [--width W] [--height H] [--depth N]\n"
     "       pov_compare --all [SCENES_DIR] [--out DIR] [--width W] [--height H]\n"
-    "       common options: [--povray PATH] [--lens-inc FILE] [--threads N] [--quiet]\n"
+    "       common options: [--povray PATH] [--lens-inc FILE] [-L DIR]... [--threads N]\n"
+    "                       [--quiet]\n"
     "       pov_compare --help\n"
     "\n"
     "Renders SCENE (a .scene file) in POV-Ray 3.7 and in this renderer, in\n"
@@ -60,11 +63,16 @@ static const char usage_text[] =
     "  --width W        image width, 1..16384 (default 320)\n"
     "  --height H       image height, 1..16384 (default 240)\n"
     "  --depth N        max trace level 1..256 (default: the scene's)\n"
-    "  --all [DIR]      compare every DIR/*.scene (default DIR: scenes) and\n"
+    "  --all [DIR]      compare every DIR/*.scene (default DIR: ./scenes, else the\n"
+    "                   installed share/lensprim/scenes) and\n"
     "                   write index.md and index.html into the output directory\n"
     "  --povray PATH    the POV-Ray executable (default: povray on PATH)\n"
-    "  --lens-inc FILE  the lens macro file the .pov includes (default: lens.inc\n"
-    "                   next to the scene, else the project's scenes/lens.inc)\n"
+    "  --lens-inc FILE  the lens macro file the .pov includes; by default lens.inc\n"
+    "                   is looked for next to the scene, in each -L directory,\n"
+    "                   in the installed share/lensprim, in the source tree of\n"
+    "                   the build\n"
+    "  -L DIR, +LDIR, --library-path DIR\n"
+    "                   a POV-Ray library path (repeatable, in order)\n"
     "  --threads N      threads for both renderers, 1..1024 (default: every core)\n"
     "  -q, --quiet      print nothing but errors\n"
     "  -h, --help       this text\n"
@@ -76,7 +84,7 @@ static const char usage_text[] =
     "(ours in fresnel mode | POV-Ray | difference), report.json, report.md.\n"
     "\n"
     "Exit status: 0 success, 1 a render or output failed (POV-Ray missing\n"
-    "included), 2 bad input.\n";
+    "included), 2 bad input: the scene, lens.inc or the output directory.\n";
 
 typedef struct options {
     int help, all, quiet;
@@ -84,6 +92,8 @@ typedef struct options {
     const char *out;
     const char *povray;
     const char *lens_inc;
+    const char *library_paths[LIBRARY_PATHS_MAX]; /* -L, in order */
+    int n_library_paths;
     int width, height, depth, threads;
 } options;
 
@@ -98,18 +108,7 @@ typedef struct summary {
     size_t n_notes;
 } summary;
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 1, 2)))
-#endif
-static void say(const char *fmt, ...)
-{
-    va_list ap;
-    fputs("pov_compare: ", stderr);
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fputc('\n', stderr);
-}
+#define say(...) sp_say("pov_compare", __VA_ARGS__)
 
 /* A progress line on a terminal (not with --quiet, not into files). */
 static void progress(const options *o, const char *scene, const char *stage)
@@ -117,13 +116,6 @@ static void progress(const options *o, const char *scene, const char *stage)
     if (o->quiet || !isatty(STDERR_FILENO))
         return;
     fprintf(stderr, "pov_compare: %s: %s\n", scene, stage);
-}
-
-static double now_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
 /* ---- the command line ---- */
@@ -150,6 +142,25 @@ static int parse_args(int argc, char **argv, options *o)
     for (int i = 1; i < argc; i++) {
         const char *arg = argv[i], *val = NULL;
         char name[64];
+        if (!no_more_options &&
+            (strncmp(arg, "+L", 2) == 0 || strncmp(arg, "-L", 2) == 0 ||
+             strcmp(arg, "--library-path") == 0 ||
+             strncmp(arg, "--library-path=", 15) == 0)) {
+            /* POV-Ray's +LDIR, and -L DIR / -LDIR / --library-path DIR */
+            const char *dir = arg[0] == '+' || (arg[1] == 'L' && arg[2]) ? arg + 2
+                              : arg[14] == '=' ? arg + 15
+                              : i + 1 < argc ? argv[++i] : NULL;
+            if (!dir || !*dir) {
+                say("%s needs a directory", arg);
+                return -1;
+            }
+            if (o->n_library_paths >= LIBRARY_PATHS_MAX) {
+                say("more than %d library paths", LIBRARY_PATHS_MAX);
+                return -1;
+            }
+            o->library_paths[o->n_library_paths++] = dir;
+            continue;
+        }
         if (no_more_options || arg[0] != '-' || arg[1] == '\0') {
             if (o->positional) {
                 say("unexpected argument '%s' (one %s only)", arg,
@@ -250,34 +261,6 @@ static int parse_args(int argc, char **argv, options *o)
 
 /* ---- files and directories ---- */
 
-static int mkdir_p(const char *path, char *msg, size_t msg_size)
-{
-    char buf[PATH_MAX];
-    struct stat st;
-    if (snprintf(buf, sizeof buf, "%s", path) >= (int)sizeof buf) {
-        snprintf(msg, msg_size, "%s: path too long", path);
-        return -1;
-    }
-    for (char *p = buf + 1; ; p++) {
-        if (*p == '/' || *p == '\0') {
-            char c = *p;
-            *p = '\0';
-            if (mkdir(buf, 0755) != 0 && errno != EEXIST) {
-                snprintf(msg, msg_size, "%s: cannot create directory: %s", buf, strerror(errno));
-                return -1;
-            }
-            *p = c;
-            if (c == '\0')
-                break;
-        }
-    }
-    if (stat(path, &st) != 0 || !S_ISDIR(st.st_mode)) {
-        snprintf(msg, msg_size, "%s: not a directory", path);
-        return -1;
-    }
-    return 0;
-}
-
 static int is_file(const char *path)
 {
     struct stat st;
@@ -318,21 +301,36 @@ static void scene_name(const char *path, char *out, size_t size)
     snprintf(out, size, "%.*s", (int)n, b);
 }
 
-/* The project's scenes directory seen from the executable: build/bin/../../scenes. */
-static int exe_scenes_dir(char *out, size_t size)
+/* The installed share directory seen from the executable:
+ * <exe dir>/LP_BIN_TO_SHARE (bin/../share/lensprim when installed), so an
+ * install can be moved. */
+static int exe_share_dir(char *out, size_t size)
 {
+#ifdef LP_BIN_TO_SHARE
     char exe[PATH_MAX], d1[PATH_MAX];
     ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
     if (n <= 0)
         return -1;
     exe[n] = '\0';
     dir_of(exe, d1, sizeof d1);
-    if (snprintf(out, size, "%s/../../scenes", d1) >= (int)size)
+    if (snprintf(out, size, "%s/%s", d1, LP_BIN_TO_SHARE) >= (int)size)
         return -1;
     return is_dir(out) ? 0 : -1;
+#else
+    (void)out;
+    (void)size;
+    return -1;
+#endif
 }
 
-/* Where lens.inc is: --lens-inc, next to the scene, the project's scenes. */
+/* dir/lens.inc into out when it is a file. */
+static int lens_inc_in(const char *dir, char *out, size_t size)
+{
+    return snprintf(out, size, "%s/lens.inc", dir) < (int)size && is_file(out) ? 0 : -1;
+}
+
+/* Where lens.inc is: --lens-inc, next to the scene, the library paths,
+ * the installed share directory, the source tree of the build. */
 static int find_lens_inc(const options *o, const char *scene_path, char *out, size_t size)
 {
     char dir[PATH_MAX];
@@ -341,13 +339,15 @@ static int find_lens_inc(const options *o, const char *scene_path, char *out, si
         return is_file(out) ? 0 : -1;
     }
     dir_of(scene_path, dir, sizeof dir);
-    if (snprintf(out, size, "%s/lens.inc", dir) < (int)size && is_file(out))
+    if (lens_inc_in(dir, out, size) == 0)
         return 0;
-    if (exe_scenes_dir(dir, sizeof dir) == 0 &&
-        snprintf(out, size, "%s/lens.inc", dir) < (int)size && is_file(out))
+    for (int k = 0; k < o->n_library_paths; k++)
+        if (lens_inc_in(o->library_paths[k], out, size) == 0)
+            return 0;
+    if (exe_share_dir(dir, sizeof dir) == 0 && lens_inc_in(dir, out, size) == 0)
         return 0;
-#ifdef LP_SOURCE_DIR
-    if (snprintf(out, size, "%s/scenes/lens.inc", LP_SOURCE_DIR) < (int)size && is_file(out))
+#ifdef LP_BUILD_SCENES_DIR
+    if (lens_inc_in(LP_BUILD_SCENES_DIR, out, size) == 0)
         return 0;
 #endif
     return -1;
@@ -391,7 +391,7 @@ static int render_ours(const rs_scene *scene, rs_mode mode, int width, int heigh
 {
     rs_render_opts ro;
     rs_integrator *it = NULL;
-    double t0 = now_seconds();
+    double t0 = sp_now_seconds();
 
     rs_render_opts_init(&ro);
     ro.mode = mode;
@@ -411,7 +411,7 @@ static int render_ours(const rs_scene *scene, rs_mode mode, int width, int heigh
     int rc = rs_render_tiles(width, height, TILE_SIZE, threads, worker_make, worker_free,
                              render_tile, &ctx, -1);
     rs_integrator_destroy(it);
-    *seconds = now_seconds() - t0;
+    *seconds = sp_now_seconds() - t0;
     if (rc != 0) {
         rs_image_free(img);
         snprintf(msg, msg_size, "the %s render failed (out of memory for a worker thread)",
@@ -532,8 +532,8 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
         FAIL(EXIT_BAD, "%s", msg);
     if (rs_camera_setup(&st.scene.camera, w, h, &view, msg, sizeof msg) != 0)
         FAIL(EXIT_BAD, "%s: camera: %s", scene_path, msg);
-    if (mkdir_p(out_dir, msg, sizeof msg) != 0)
-        FAIL(EXIT_RENDER, "%s", msg);
+    if (sp_mkdir_p(out_dir, msg, sizeof msg) != 0)
+        FAIL(EXIT_BAD, "%s", msg);
 
     rep->scene = base_of(scene_path);
     rep->width = w;
@@ -548,9 +548,10 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
     if (find_lens_inc(o, scene_path, lens_inc, sizeof lens_inc) != 0) {
         if (o->lens_inc)
             FAIL(EXIT_BAD, "--lens-inc %s: no such file", o->lens_inc);
-        FAIL(EXIT_RENDER,
-             "lens.inc not found (looked next to %s and in the project's scenes "
-             "directory): pass --lens-inc FILE",
+        FAIL(EXIT_BAD,
+             "lens.inc not found (looked next to %s, in the -L directories, in the "
+             "installed share/lensprim and in the build's source tree): pass "
+             "--lens-inc FILE",
              scene_path);
     }
     if (path_in(path, sizeof path, out_dir, "lens.inc") ||
@@ -883,8 +884,12 @@ static int compare_all(const options *o)
         snprintf(dir, sizeof dir, "%s", o->positional);
     else if (is_dir("scenes"))
         snprintf(dir, sizeof dir, "scenes");
-    else if (exe_scenes_dir(dir, sizeof dir) != 0) {
-        say("--all: no scenes directory given and none found (./scenes)");
+    else if (exe_share_dir(dir, sizeof dir) == 0 &&
+             strlen(dir) + sizeof "/scenes" <= sizeof dir && is_dir(strcat(dir, "/scenes")))
+        ; /* the installed examples */
+    else {
+        say("--all: no scenes directory given and none found (./scenes, the installed "
+            "share/lensprim/scenes)");
         return EXIT_BAD;
     }
     char **names = list_scenes(dir, &n, msg, sizeof msg);
@@ -924,7 +929,7 @@ static int compare_all(const options *o)
             break;
     }
     if (done > 0) {
-        if (mkdir_p(out_root, msg, sizeof msg) != 0 ||
+        if (sp_mkdir_p(out_root, msg, sizeof msg) != 0 ||
             write_index(out_root, sums, done, o, msg, sizeof msg) != 0) {
             say("%s", msg);
             status = EXIT_RENDER;

@@ -14,15 +14,9 @@
 #include <unistd.h>
 
 #include "povray.h"
+#include "support/cli.h"
 
 #define ARG_MAX_LEN 64
-
-static double now_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
 
 static int is_executable(const char *path)
 {
@@ -178,7 +172,7 @@ pc_povray_status pc_povray_render(const pc_povray_job *job, rs_image *out, doubl
         return PC_POVRAY_SYSTEM;
     }
     fflush(NULL);
-    t0 = now_seconds();
+    t0 = sp_now_seconds();
     pid = fork();
     if (pid < 0) {
         snprintf(msg, msg_size, "fork: %s", strerror(errno));
@@ -221,7 +215,7 @@ pc_povray_status pc_povray_render(const pc_povray_job *job, rs_image *out, doubl
     do
         w = waitpid(pid, &status, 0);
     while (w < 0 && errno == EINTR);
-    *seconds = now_seconds() - t0;
+    *seconds = sp_now_seconds() - t0;
     if (w < 0) {
         snprintf(msg, msg_size, "waitpid: %s", strerror(errno));
         return PC_POVRAY_SYSTEM;

@@ -1,6 +1,6 @@
 /* translate.c -- a parsed .scene as a POV-Ray 3.7 scene (see translate.h).
  *
- * The rules follow the measured facts of shared/notes/povray.md:
+ * The rules follow POV-Ray 3.7's measured behaviour:
  *   - `#version 3.7;` first, assumed_gamma 1, adc_bailout 0 (depth alone
  *     decides); every finish written out in full as the scene holds it
  *     (ambient, diffuse, brilliance, emission, phong, phong_size, specular,

@@ -193,6 +193,39 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
     }
 
     v.orthographic = cam->orthographic;
+    /* 5. focal blur. */
+    v.lens_radius = 0.0;
+    v.focal_distance = 0.0;
+    v.lens_x = v_unit(v.R);
+    v.lens_y = v_unit(v.U);
+    v.samples = 1;
+    if (!isfinite(cam->aperture) || cam->aperture < 0.0)
+        return fail(msg, msg_size, "camera: the aperture %g is not a finite size >= 0",
+                    cam->aperture);
+    if (cam->blur_samples < 0)
+        return fail(msg, msg_size, "camera: blur_samples %d is negative", cam->blur_samples);
+    if (cam->aperture > 0.0 && cam->orthographic)
+        return fail(msg, msg_size, "camera: focal blur (aperture) with an orthographic camera "
+                                   "is not supported");
+    if (cam->aperture > 0.0) {
+        lp_vec3 fp = cam->has_xf ? rs_xf_point(&cam->xf, cam->focal_point) : cam->focal_point;
+        lp_vec3 dh = v_unit(v.D), x;
+        if (!v_finite(fp))
+            return fail(msg, msg_size, "camera: the focal point is not finite");
+        v.focal_distance = v_len(v_sub(fp, v.location));
+        if (!(v.focal_distance > RS_CAMERA_EPSILON * (1.0 + v_len(v.location))))
+            return fail(msg, msg_size,
+                        "camera: with an aperture the focal point must differ from the "
+                        "location");
+        x = v_sub(v.R, v_scale(dh, v_dot(v.R, dh)));
+        if (!(v_len(x) > 0.0))
+            x = v_sub(v.U, v_scale(dh, v_dot(v.U, dh)));
+        v.lens_x = v_unit(x);
+        v.lens_y = v_cross(dh, v.lens_x);
+        v.lens_radius = 0.5 * cam->aperture;
+        v.samples = cam->blur_samples > 0 ? cam->blur_samples : RS_CAMERA_BLUR_SAMPLES;
+    }
+
     *out = v;
     return 0;
 }
@@ -210,4 +243,25 @@ void rs_camera_ray(const rs_view *v, double px, double py, int width,
     lp_vec3 d = v_add(v_add(v->D, v_scale(v->R, x0)), v_scale(v->U, y0));
     *origin = v->location;
     *dir = v_unit(d);
+}
+
+void rs_camera_aperture_ray(const rs_view *v, double px, double py, int width,
+                            int height, int k, lp_vec3 *origin, lp_vec3 *dir)
+{
+    /* the golden angle, pi (3 - sqrt 5) */
+    const double golden = rs_camera_pi * (3.0 - 2.2360679774997896964);
+    lp_vec3 o, d, focus, a;
+    double r, phi;
+    rs_camera_ray(v, px, py, width, height, &o, &d);
+    if (v->samples <= 1 || !(v->lens_radius > 0.0)) {
+        *origin = o;
+        *dir = d;
+        return;
+    }
+    focus = v_add(o, v_scale(d, v->focal_distance));
+    r = v->lens_radius * sqrt((k + 0.5) / v->samples);
+    phi = golden * k;
+    a = v_add(v_scale(v->lens_x, r * cos(phi)), v_scale(v->lens_y, r * sin(phi)));
+    *origin = v_add(o, a);
+    *dir = v_unit(v_sub(focus, *origin));
 }

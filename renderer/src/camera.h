@@ -36,6 +36,19 @@
  *   dir = normalize(D + (px/W - 0.5) R + (0.5 - py/H) U), origin = location.
  * Orthographic (`orthographic`): dir = normalize(D) for every pixel,
  *   origin = location + (px/W - 0.5) R + (0.5 - py/H) U.
+ *
+ * Focal blur (POV-Ray's focal_point and aperture): with aperture A > 0 the
+ * camera is a thin lens, a disk of radius A/2 about the location,
+ * perpendicular to D, in focus at the distance F = |focal_point -
+ * location| (focal_point is transformed with the camera; the surface in
+ * focus is the sphere of radius F about the location, as in POV-Ray).  A
+ * pixel is the mean of blur_samples rays (default RS_CAMERA_BLUR_SAMPLES),
+ * each from a point of the disk through the pixel's point in focus,
+ * location + F dir.  The disk points are a deterministic sunflower
+ * quadrature of equal areas: sample k of N at radius (A/2) sqrt((k+1/2)/N)
+ * and azimuth k times the golden angle (POV-Ray jitters its samples; here
+ * a picture is the same on every run).  Aperture 0 (the default) is a
+ * pinhole: one ray per pixel, everything in focus.
  */
 #ifndef RS_CAMERA_H
 #define RS_CAMERA_H
@@ -55,7 +68,14 @@ typedef struct rs_view {
     int orthographic; /* rays along D from location + x0 R + y0 U (the
                          image is |R| by |U| scene units), POV-Ray's
                          orthographic camera */
+    double lens_radius;    /* aperture / 2; 0: a pinhole */
+    double focal_distance; /* |focal_point - location| */
+    lp_vec3 lens_x, lens_y; /* unit, spanning the lens disk (perpendicular to D) */
+    int samples;           /* rays per pixel: 1 for a pinhole */
 } rs_view;
+
+/* Aperture rays per pixel when the scene gives no blur_samples. */
+#define RS_CAMERA_BLUR_SAMPLES 16
 
 /* Build *out from the camera keywords *cam by the rules above.  width and
  * height are the image size in pixels (both >= 1); POV-Ray does not adapt
@@ -69,7 +89,9 @@ typedef struct rs_view {
  *   vanishes because the kept right is parallel to the view direction);
  *   location and look_at coincide (|P - location|^2 < 1e-10, POV-Ray's
  *   test); D, R and U are coplanar (every ray would lie in one plane);
- *   width or height < 1; the transform makes the camera degenerate. */
+ *   width or height < 1; the transform makes the camera degenerate; the
+ *   aperture is negative or not finite, or positive with the focal point
+ *   at the location; blur_samples is negative. */
 int rs_camera_setup(const rs_camera *cam, int width, int height,
                     rs_view *out, char *msg, size_t msg_size);
 
@@ -81,5 +103,11 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
  * rs_camera_setup accepted.  Pure: safe from any number of threads. */
 void rs_camera_ray(const rs_view *v, double px, double py, int width,
                    int height, lp_vec3 *origin, lp_vec3 *dir);
+
+/* Aperture ray k (0 <= k < v->samples) through image point (px, py): for
+ * a pinhole the primary ray above; else from the k-th point of the lens
+ * disk towards location + F dir (the rules above).  Pure, as above. */
+void rs_camera_aperture_ray(const rs_view *v, double px, double py, int width,
+                            int height, int k, lp_vec3 *origin, lp_vec3 *dir);
 
 #endif

@@ -15,12 +15,18 @@
  * complex amplitudes sqrt(I) vp exp(i(2 pi op/lambda - pi kphi + phase)),
  * all others as intensities.
  *
- * Optical path outside lenses: a surface point X seen along unit d
- * starts its rays with the phase of one plane wavefront per pixel,
- * perpendicular to the camera ray through the point P where it first meets
- * the scene (plane_op), and every segment of length t adds n t (the scene
- * medium is air, n = 1), so a ray's op is referred to the origin of the
- * ray being traced, as lp_backward_gather expects of a bundle.
+ * Optical path outside lenses: every segment of length t adds n t (the
+ * scene medium is air, n = 1), so a ray's op is referred to the origin of
+ * the ray being traced, as lp_backward_gather expects of a bundle.  Where
+ * a traced ray meets a source (an emitting or diffusing surface, or the
+ * background), its last segment is recorded as a wavelet (coherence.h)
+ * and its rays start with op = 0 there; rs_coherent_power joins the
+ * wavelets of each pair of beams to one common source point.
+ *
+ * Camera: a pinhole (aperture 0) traces one ray per pixel; with an
+ * aperture the pixel is the mean power of the camera's aperture rays,
+ * all through the pixel's point on the focal surface (camera.h), so what
+ * lies off the focal surface -- fringes included -- is blurred.
  *
  * Levels follow POV-Ray: the camera ray is level 1; a query ray of depth
  * k from a lens hit at level L is level L + k; a ray that needs a level
@@ -33,6 +39,7 @@
 #include <string.h>
 
 #include "camera.h"
+#include "coherence.h"
 #include "integrator.h"
 #include "shapes.h"
 #include "emitter.h"
@@ -79,8 +86,7 @@ struct rs_worker {
     const rs_integrator *it;
     frame *frames[RS_MAX_FRAMES];
     bundle pixel;
-    lp_vec3 ref;     /* the pixel's phase reference point (see plane_op) */
-    lp_vec3 ref_dir; /* and the direction of its camera ray */
+    rs_wavelets wavelets; /* of the band being traced (coherence.h) */
 };
 
 /* Source ids: 0 ambient, 1 background, 2 + k light k, 2 + L + i object i. */
@@ -261,6 +267,7 @@ void rs_worker_destroy(rs_worker *w)
         free(w->frames[f]);
     }
     free(w->pixel.r);
+    rs_wavelets_free(&w->wavelets);
     free(w);
 }
 
@@ -621,7 +628,7 @@ static double trace_scalar(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, in
 typedef struct emit_ctx {
     bundle *out;
     lp_vec3 d;
-    double op;
+    long wavelet; /* its index in the worker's table */
 } emit_ctx;
 
 /* Natural light of one source as two orthogonal incoherent halves. */
@@ -637,8 +644,8 @@ static void emit_halves(void *ctx, int source, double radiance)
         memset(r, 0, sizeof *r);
         r->intensity = 0.5 * radiance;
         r->vp = half ? v2 : v1;
-        r->op = e->op;
-        r->ch = 2u * (uint64_t)source + (uint64_t)half;
+        r->op = 0.0;
+        r->ch = rs_coherence_ch(e->wavelet, source, half);
     }
 }
 
@@ -648,19 +655,13 @@ static void shift_op(bundle *out, size_t from, double dop)
         out->r[i].op += dop;
 }
 
-/* The optical path a ray starts with where it leaves an emitter, referred
- * to the origin o of the ray being traced: that of a plane wavefront
- * perpendicular to the pixel's camera ray through the pixel's reference
- * point P (where the camera ray first meets the scene), c.(o - P).  All
- * rays of one pixel split near P, so they compare their optical paths from
- * one common wavefront; the result does not depend on where the world
- * origin is, and rays leaving one flat face (as in Newton's rings) get no
- * spurious path difference from their slightly different directions. */
-static double plane_op(const rs_worker *w, lp_vec3 o, lp_vec3 d)
+/* Record the last segment of a traced ray, from o along d to the source
+ * it meets at s (object `emitter`; -1 and s unused for the background);
+ * its index, or -1 when out of memory. */
+static long record_wavelet(rs_worker *w, lp_vec3 o, lp_vec3 d, const rs_hit *h)
 {
-    (void)d;
-    const lp_vec3 c = w->ref_dir;
-    return c.x * (o.x - w->ref.x) + c.y * (o.y - w->ref.y) + c.z * (o.z - w->ref.z);
+    rs_wavelet wl = {o, d, h ? h->point : o, h != NULL, h ? h->object : -1};
+    return rs_wavelets_push(&w->wavelets, &wl);
 }
 
 static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
@@ -702,9 +703,11 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
     size_t start = out->n;
 
     if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
-        emit_ctx e = {out, d, -plane_op(w, o, d)};
         double L = band_emission(b, sc->background);
-        if (L != 0.0)
+        if (L == 0.0)
+            return;
+        emit_ctx e = {out, d, record_wavelet(w, o, d, NULL)};
+        if (e.wavelet >= 0)
             emit_halves(&e, 1, L);
         return;
     }
@@ -769,44 +772,11 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
         shift_op(out, start, h.t);
         return;
     }
-    emit_ctx e = {out, d, -plane_op(w, o, d)};
-    shade(it, b, &h, d, emit_halves, &e);
+    emit_ctx e = {out, d, record_wavelet(w, o, d, &h)};
+    if (e.wavelet >= 0)
+        shade(it, b, &h, d, emit_halves, &e);
     if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES)
         mirror_pol(w, b, ob, &h, d, level, weight, f, fr, out);
-}
-
-/* Power seen at the pixel.  Rays of incoherent sources add intensities;
- * rays of one coherent source and half (one ch) add as amplitudes, each
- * pair with the visibility gamma = exp(-(dop/L)^2) of the source's
- * coherence length L (gamma = 1 for L = 0, infinite):
- *     P = sum_i I_i + sum_{i<j} 2 gamma_ij Re(A_i . conj A_j). */
-static double bundle_power(const rs_integrator *it, const bundle *bd, double lambda)
-{
-    double total = 0.0;
-    double k0 = 2.0 * RS_PI / (lambda * 1e-6);
-
-    for (size_t i = 0; i < bd->n; i++) {
-        const lp_ray *a = &bd->r[i];
-        total += a->intensity;
-        uint64_t src = a->ch / 2;
-        if (src >= (uint64_t)it->n_sources || !it->coherent[src] || a->intensity == 0.0)
-            continue;
-        double lc = it->coherence[src];
-        double pa = k0 * a->op - RS_PI * a->kphi + a->phase;
-        for (size_t j = i + 1; j < bd->n; j++) {
-            const lp_ray *b = &bd->r[j];
-            if (b->ch != a->ch || b->intensity == 0.0)
-                continue;
-            double dop = a->op - b->op;
-            double gamma = lc > 0.0 ? exp(-(dop / lc) * (dop / lc)) : 1.0;
-            if (gamma < 1e-12)
-                continue;
-            double pb = k0 * b->op - RS_PI * b->kphi + b->phase;
-            double vv = a->vp.x * b->vp.x + a->vp.y * b->vp.y + a->vp.z * b->vp.z;
-            total += 2.0 * gamma * sqrt(a->intensity * b->intensity) * vv * cos(pa - pb);
-        }
-    }
-    return total > 0.0 ? total : 0.0;
 }
 
 static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
@@ -814,20 +784,16 @@ static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
     const rs_integrator *it = w->it;
     if (it->opts.mode != RS_MODE_POLARIZED)
         return trace_scalar(w, b, o, d, 1, 1.0, -1, 0);
-    rs_hit h;
     w->pixel.n = 0;
-    w->ref = rs_scene_intersect(it->scene, o, d, 0.0, INFINITY, -1, &h) ? h.point : o;
-    w->ref_dir = d;
+    w->wavelets.n = 0;
     trace_pol(w, b, o, d, 1, 1.0, -1, 0, &w->pixel);
-    return bundle_power(it, &w->pixel, b->lambda);
+    return rs_coherent_power(w->pixel.r, w->pixel.n, &w->wavelets, it->coherent, it->coherence,
+                             it->n_sources, b->lambda);
 }
 
-/* The colour seen along the camera ray through image point (px, py). */
-static void sample(const rs_integrator *it, rs_worker *w, double px, double py, rs_color *out)
+/* Linear sRGB that the camera ray (o, d) brings. */
+static void ray_colour(const rs_integrator *it, rs_worker *w, lp_vec3 o, lp_vec3 d, rs_color *out)
 {
-    lp_vec3 o, d;
-    rs_camera_ray(&it->view, px, py, it->opts.width, it->opts.height, &o, &d);
-
     if (it->opts.mode == RS_MODE_RGB) {
         double v[3];
         for (int c = 0; c < 3; c++) {
@@ -873,21 +839,23 @@ static void sample(const rs_integrator *it, rs_worker *w, double px, double py, 
 
 void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs_color *out)
 {
-    int n = it->opts.aa > 1 ? it->opts.aa : 1;
+    int aa = it->opts.aa > 1 ? it->opts.aa : 1;
+    int n = it->view.samples > 0 ? it->view.samples : 1;
     rs_color sum = {0, 0, 0};
-    if (n == 1) {
-        sample(it, w, i + 0.5, j + 0.5, out);
-        return;
-    }
-    for (int b = 0; b < n; b++)
-        for (int a = 0; a < n; a++) {
+    /* aa x aa points of the pixel (antialiasing), each with the camera's n
+     * aperture rays */
+    for (int q = 0; q < aa * aa; q++) {
+        double px = i + (q % aa + 0.5) / aa, py = j + (q / aa + 0.5) / aa;
+        for (int k = 0; k < n; k++) {
+            lp_vec3 o, d;
             rs_color c;
-            sample(it, w, i + (a + 0.5) / n, j + (b + 0.5) / n, &c);
+            rs_camera_aperture_ray(&it->view, px, py, it->opts.width, it->opts.height, k, &o,
+                                   &d);
+            ray_colour(it, w, o, d, &c);
             sum.r += c.r;
             sum.g += c.g;
             sum.b += c.b;
         }
-    out->r = sum.r / (n * n);
-    out->g = sum.g / (n * n);
-    out->b = sum.b / (n * n);
+    }
+    *out = (rs_color){sum.r / (n * aa * aa), sum.g / (n * aa * aa), sum.b / (n * aa * aa)};
 }

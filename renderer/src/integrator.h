@@ -48,8 +48,10 @@ rs_worker *rs_worker_create(const rs_integrator *it);
 void rs_worker_destroy(rs_worker *w);
 
 /* Linear sRGB of pixel (i, j), i = column from the left, j = row from the
- * top: the mean of its aa x aa samples.  Deterministic for a given scene,
- * options and pixel (no random numbers, whatever thread renders it). */
+ * top: the mean of its aa x aa points (antialiasing), each what its camera
+ * ray brings, or with a camera aperture the mean of its aperture rays
+ * (camera.h).  Deterministic for a given scene, options and pixel (no
+ * random numbers, whatever thread renders it). */
 void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j,
                          rs_color *out);
 

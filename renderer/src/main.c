@@ -13,6 +13,7 @@
 
 #include "args.h"
 #include "camera.h"
+#include "support/cli.h"
 #include "support/image.h"
 #include "integrator.h"
 #include "library_path.h"
@@ -34,7 +35,10 @@ static const char *const usage_text[] = {
 "       lensrender --help | --version\n"
 "\n",
 "Renders SCENE, a POV-Ray-style .scene file with lenses, to an 8-bit sRGB\n"
-"PNG.  The image is the same whatever --threads is.\n"
+"PNG.  The image is the same whatever --threads is.  Lengths are in\n"
+"millimetres; wavelengths (a light's spectrum { line NM }, the glass\n"
+"data, the CIE tables) are in nanometres in standard air, as glass\n"
+"catalogs and line tables give them.\n"
 "\n"
 "  -o, --output FILE   the PNG to write (default: the scene's name with\n"
 "                      .png, in the current directory)\n"
@@ -68,26 +72,21 @@ static const char *const usage_text[] = {
 "                      project's share directory when they exist\n"
 "  -q, --quiet         print nothing but errors\n"
 "  --no-dispersion     every glass becomes a constant lossless index, its\n"
-"                      index at 587.56 nm (to compare with POV-Ray)\n"
+"                      index at 587.56 nm in air, the d line (to compare\n"
+"                      with POV-Ray)\n"
 "  -h, --help          this text\n"
 "  -V, --version       the version\n"
 "\n"
 "Exit status: 0 success, 1 render or output failure, 2 bad input.\n",
 };
 
-static void say(const char *fmt_prefix, const char *msg)
+/* One line "lensrender: [PREFIX: ]MESSAGE" on stderr. */
+static void say(const char *prefix, const char *msg)
 {
-    if (fmt_prefix)
-        fprintf(stderr, "lensrender: %s: %s\n", fmt_prefix, msg);
+    if (prefix)
+        sp_say("lensrender", "%s: %s", prefix, msg);
     else
-        fprintf(stderr, "lensrender: %s\n", msg);
-}
-
-static double now_seconds(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+        sp_say("lensrender", "%s", msg);
 }
 
 /* What --mode auto picks, and why (for the message). */
@@ -177,7 +176,7 @@ static int run(const rs_args *a)
     render_ctx ctx;
     rs_mode mode = a->mode;
     int depth, status = 0;
-    double t0 = now_seconds();
+    double t0 = sp_now_seconds();
 
     memset(&img, 0, sizeof img);
     rs_scene_init(&scene);
@@ -273,7 +272,7 @@ static int run(const rs_args *a)
                 "lensrender: wrote %s (%d x %d, %s, %d wavelengths, depth %d) "
                 "in %.2f s\n",
                 a->out_png, a->width, a->height, rs_mode_name(mode),
-                a->wavelengths, depth, now_seconds() - t0);
+                a->wavelengths, depth, sp_now_seconds() - t0);
 
 done:
     rs_image_free(&img);

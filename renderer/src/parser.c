@@ -176,7 +176,7 @@ static const char *const reserved_words[] = {
     /* scene items and their keywords */
     "camera", "perspective", "orthographic", "fisheye", "ultra_wide_angle", "omnimax",
     "panoramic", "cylinder", "spherical", "location", "look_at", "angle", "right", "up",
-    "direction", "sky", "light_source", "polarization", "spectrum", "blackbody", "line",
+    "direction", "sky", "focal_point", "aperture", "blur_samples", "light_source", "polarization", "spectrum", "blackbody", "line",
     "coherent", "background", "global_settings", "max_trace_level", "adc_bailout",
     "ambient_light", "assumed_gamma", "plane", "sphere", "box", "disc", "lens", "radius1",
     "radius2", "thickness", "diameter", "diameter2", "glass", "ior", "sellmeier", "medium",
@@ -2352,6 +2352,26 @@ static int parse_camera(parser *p)
             c->has_angle = 1;
             continue;
         }
+        if (is_id(t, "aperture") || is_id(t, "blur_samples")) {
+            int aperture = is_id(t, "aperture");
+            rs_token start;
+            double f;
+            take(p);
+            start = *peek(p);
+            if (parse_float(p, aperture ? "the aperture" : "blur_samples", &f) != 0)
+                return -1;
+            if (aperture && !(f >= 0.0 && f < INFINITY))
+                return error_at(p, start.line, start.column,
+                                "the aperture must be a finite size >= 0");
+            if (!aperture && !(f >= 1.0 && f < 4097.0))
+                return error_at(p, start.line, start.column,
+                                "blur_samples must be between 1 and 4096");
+            if (aperture)
+                c->aperture = f;
+            else
+                c->blur_samples = (int)f;
+            continue;
+        }
         if (transform_kind(t) != XF_NONE) {
             rs_transform step;
             rs_token kw;
@@ -2362,7 +2382,9 @@ static int parse_camera(parser *p)
             c->has_xf = 1;
             continue;
         }
-        if (is_id(t, "location"))
+        if (is_id(t, "focal_point"))
+            target = &c->focal_point;
+        else if (is_id(t, "location"))
             target = &c->location;
         else if (is_id(t, "look_at"))
             target = &c->look_at;
@@ -2376,8 +2398,8 @@ static int parse_camera(parser *p)
             target = &c->sky;
         if (target == NULL)
             return expected(p, t, "perspective, orthographic, location, look_at, angle, right, "
-                                  "up, direction, sky, translate, rotate, scale or '}' in "
-                                  "camera");
+                                  "up, direction, sky, focal_point, aperture, blur_samples, "
+                                  "translate, rotate, scale or '}' in camera");
         if (target == &c->look_at)
             c->has_look_at = 1;
         take(p);

@@ -27,6 +27,9 @@ void rs_scene_init(rs_scene *scene)
     c->has_angle = 0;
     rs_transform_identity(&c->xf);
     c->has_xf = 0;
+    c->focal_point = (lp_vec3){ 0.0, 0.0, 0.0 };
+    c->aperture = 0.0;
+    c->blur_samples = 0;
 
     scene->background = (rs_color){ 0.0, 0.0, 0.0 };
 

@@ -157,6 +157,10 @@ typedef struct rs_camera {
     int has_xf;
     int orthographic;       /* rays parallel to direction, from the plane
                                spanned by right and up through location */
+    lp_vec3 focal_point;    /* default <0,0,0>: the point in focus */
+    double aperture;        /* default 0: a pinhole; else the diameter of
+                               the lens disk (camera.h) */
+    int blur_samples;       /* aperture rays per pixel; 0: the default */
 } rs_camera;
 
 typedef struct rs_settings {

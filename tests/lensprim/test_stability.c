@@ -1,5 +1,5 @@
 /* test_stability.c -- numerical stability of lensprim at the limits of
- * its model (issue 5, item 1), one section per case:
+ * its model, one section per case:
  *
  *   grazing    incidence 90 deg - 10^-k rad                (test_grazing)
  *   critical   theta_c -+ 10^-k, at the node and in glass  (test_critical)

@@ -1,6 +1,6 @@
 /* test_hostile_input.c -- hostile input to lenstrace's argument parser,
  * to the AGF catalog reader and to lp_lens_create: a clear error, never
- * a crash, a hang or unbounded memory (issue 5, item 3).
+ * a crash, a hang or unbounded memory.
  *
  *   - every input kept in tests/regressions/lenstrace_args/ (one argv word
  *     per line, as fuzz/fuzz_lenstrace_args reads them) is parsed again by
@@ -314,6 +314,10 @@ static void test_hostile_args(void)
         { { "--lens", "R1=50,R2=-50,t=5,D=25,n=1.5", "--ray", "o=0,1,-10 d=0,0,1 vp=0,0,1e300" },
           "--ray: vp is parallel to d" },
         { { "--lens", "R1=50,R2=-50,t=5,D=25,n=1.5", "--ray", "o=0,1,-10 d=0,0,1 lambda=1e-300" },
+          "--ray: lambda must be at least 160 nm" },
+        { { "--lens", "R1=50,R2=-50,t=5,D=25,n=1.5", "--ray", "o=0,1,-10 d=0,0,1 lambda_vac=1e-300" },
+          "--ray: lambda_vac must be at least 160 nm" },
+        { { "--lens", "R1=50,R2=-50,t=5,D=25,n=1.5", "--ray", "o=0,1,-10 d=0,0,1 lambda_vac=1e308" },
           NULL },
         { { "--lens", "R1=50,R2=-50,t=5,D=25,n=1.5", "--ray", "o=0,1,-10 d=0,0,1 lambda=1e308" },
           NULL },

@@ -1,5 +1,5 @@
 /* test_lenstrace_cli.c -- runs the built lenstrace binary and checks its
- * contract (docs: shared/design/interfaces.md, "lenstrace"): JSON Lines
+ * contract (docs/interfaces.md, "lenstrace"): JSON Lines
  * with the contract's keys in order, the physics of an axial ray through
  * a plano-convex N-BK7 lens (closed-form normal-incidence Fresnel), the
  * energy bookkeeping, vp=unpolarized halves, --backward, and the error
@@ -28,9 +28,10 @@ static const char *const LENSTRACE = LP_BIN_DIR "/lenstrace";
 /* The lens of the contract's example: plano-convex, N-BK7. */
 static const char *const LENS = "R1=25.8,R2=inf,t=5.3,D=25.4,glass=N-BK7";
 static const double T_MM = 5.3;
-/* The helium d line, 587.5618 nm in air, is 587.5618 * n_air = 587.7247 nm
- * in vacuum (Edlen 1966 standard air, below): lenstrace's lambda= is a
- * vacuum wavelength.  N-BK7's index there comes from its Sellmeier
+/* The helium d line is 587.5618 nm in standard air, the contract's
+ * wavelength: lambda=587.5618 is the d line itself, and lambda_vac= takes
+ * the vacuum wavelength, 587.5618 * n_air = 587.7247 nm (Edlen 1966
+ * standard air, below).  N-BK7's index there comes from its Sellmeier
  * coefficients (nbk7_d(), 1.5168000; the catalog prints n_d 1.51680). */
 
 /* Edlen (1966) standard air at a vacuum wavelength (nm). */
@@ -532,21 +533,21 @@ static double nbk7_tau10(double air_nm)
 }
 
 /* The axial depth-2 transmit of LENS (two normal-incidence refractions,
- * T_MM of glass) for a ray of the given lambda= (a vacuum wavelength:
- * lenstrace traces it at lambda / n_air).  Rounding only: relative
- * tolerance 1e-14, measured <= 2.2e-16. */
-static double nbk7_depth2(double lambda_arg)
+ * T_MM of glass) for a ray of the given lambda= (in standard air, as
+ * lenstrace traces it).  Rounding only: relative tolerance 1e-14,
+ * measured <= 2.2e-16. */
+static double nbk7_depth2(double air)
 {
-    double air = lambda_arg / air_index(lambda_arg), n = nbk7_index(air);
+    double n = nbk7_index(air);
     double r = (n - 1) / (n + 1), T = 1 - r * r;
     return T * T * pow(nbk7_tau10(air), T_MM / 10.0);
 }
 
-/* N-BK7 at the d line (lambda=587.7247) */
-static double nbk7_d(void) { return nbk7_index(587.7247 / air_index(587.7247)); }
+/* N-BK7 at the d line (lambda=587.5618) */
+static double nbk7_d(void) { return nbk7_index(587.5618); }
 
 static const char *const AXIAL =
-    "o=0,0,-10 d=0,0,1 lambda=587.7247 vp=1,0,0 I=1 ch=7";
+    "o=0,0,-10 d=0,0,1 lambda=587.5618 vp=1,0,0 I=1 ch=7";
 
 /* Forward, axial, polarized: physics and shape.  Keeps the depth-2
  * transmit intensity for the backward (reciprocity) check. */
@@ -566,7 +567,7 @@ static double test_forward_axial(void)
         CHECK(r1->depth == 1 && strcmp(r1->kind, "reflect") == 0,
               "forward axial: the first line is the depth-1 reflection: %s",
               r1->text);
-        CHECK_REL(r1->I, fresnel_normal(1.0, nbk7_index(587.7247 / air_index(587.7247))),
+        CHECK_REL(r1->I, fresnel_normal(1.0, nbk7_d()),
                   1e-14, "depth-1 reflect I = ((n-1)/(n+1))^2, n from Sellmeier");
         CHECK_ABS(r1->d[2], -1.0, 1e-12, "depth-1 reflect d.z");
         CHECK_ABS(r1->o[0], 0.0, 1e-9, "depth-1 reflect o.x");
@@ -583,7 +584,7 @@ static double test_forward_axial(void)
     for (size_t i = 0; i < o.n; i++) {
         CHECK(o.rays[i].depth <= 5, "default depth 5: line %zu depth %d", i,
               o.rays[i].depth);
-        CHECK(o.rays[i].lambda == 587.7247, "lambda copied exactly: %.17g",
+        CHECK(o.rays[i].lambda == 587.5618, "lambda copied exactly: %.17g",
               o.rays[i].lambda);
         CHECK(o.rays[i].ch == 7.0, "ch copied: %g", o.rays[i].ch);
         CHECK(o.rays[i].half == -1, "no half key for a polarized ray");
@@ -598,8 +599,8 @@ static double test_forward_axial(void)
         CHECK_ABS(r2->o[0], 0.0, 1e-9, "depth-2 transmit o.x");
         CHECK_ABS(r2->o[1], 0.0, 1e-9, "depth-2 transmit o.y");
         CHECK_ABS(r2->o[2], T_MM, 1e-9, "depth-2 transmit o.z = t");
-        CHECK_REL(r2->op, air_index(587.7247) * nbk7_d() * T_MM, 1e-14,
-                  "depth-2 transmit op = n_air*n*t (absolute optical path)");
+        CHECK_REL(r2->op, nbk7_d() * T_MM, 1e-14,
+                  "depth-2 transmit op = n*t (air-relative optical path)");
         /* Two refractions keep the phase and the field direction. */
         CHECK(r2->kphi == 0, "depth-2 transmit kphi 0, got %d", r2->kphi);
         CHECK_ABS(r2->phase, 0.0, 1e-12, "depth-2 transmit phase");
@@ -608,7 +609,7 @@ static double test_forward_axial(void)
            tau_i(10 mm) = 0.998 at 580 and 620 nm (catalog data), so
            0.998^0.53 = 1 - 1.06e-3; checked with R and tau computed here
            in nbk7_depth2() (measured 2e-16; see there). */
-        CHECK_REL(r2->I, nbk7_depth2(587.7247), 1e-14,
+        CHECK_REL(r2->I, nbk7_depth2(587.5618), 1e-14,
                   "depth-2 transmit I = (1-R)^2 tau^(t/10 mm)");
         CHECK(fabs(r2->I - (1.0 - R) * (1.0 - R)) > 1e-3 * (1.0 - R) * (1.0 - R),
               "depth-2 transmit I: absorption is there");
@@ -623,7 +624,7 @@ static double test_forward_axial(void)
     {
         /* The same run with --opt=VALUE gives the same bytes. */
         proc q = run("--lens=R1=25.8,R2=inf,t=5.3,D=25.4,glass=N-BK7",
-                     "--ray=o=0,0,-10 d=0,0,1 lambda=587.7247 vp=1,0,0 I=1 ch=7",
+                     "--ray=o=0,0,-10 d=0,0,1 lambda=587.5618 vp=1,0,0 I=1 ch=7",
                      "--depth=5", "--mode=polarized", "--medium=1",
                      (const char *)NULL);
         expect_success(&q, "--opt=VALUE form");
@@ -643,7 +644,7 @@ static double test_forward_axial(void)
 static void test_absorption(void)
 {
     static output o;
-    const double lambdas[] = {587.7247, 342.2, 375.1};
+    const double lambdas[] = {587.5618, 342.2, 375.1};
     double worst = 0;
     for (size_t k = 0; k < sizeof lambdas / sizeof lambdas[0]; k++) {
         char ray[96], what[48];
@@ -691,7 +692,7 @@ static void test_unpolarized(void)
     static output o;
     const double R = fresnel_normal(1.0, nbk7_d());
     proc p = run("--lens", LENS, "--ray",
-                 "o=0,0,-10 d=0,0,1 lambda=587.7247 vp=unpolarized ch=2",
+                 "o=0,0,-10 d=0,0,1 lambda=587.5618 vp=unpolarized ch=2",
                  (const char *)NULL);
     size_t n0 = 0, n1 = 0;
     int order_ok = 1, seen1 = 0;
@@ -738,7 +739,7 @@ static void test_unpolarized(void)
     {
         /* vp omitted: unpolarized by default. */
         proc q = run("--lens", LENS, "--ray",
-                     "o=0,0,-10 d=0,0,1 lambda=587.7247 ch=2",
+                     "o=0,0,-10 d=0,0,1 lambda=587.5618 ch=2",
                      (const char *)NULL);
         expect_success(&q, "vp omitted");
         CHECK(strcmp(q.out, p.out) == 0, "vp omitted = vp=unpolarized");
@@ -753,7 +754,7 @@ static void test_backward(double forward_i2)
     static output o;
     const double R = fresnel_normal(1.0, nbk7_d());
     proc p = run("--lens", LENS, "--ray",
-                 "o=0,0,-10 d=0,0,1 lambda=587.7247 vp=1,0,0 I=1 ch=3",
+                 "o=0,0,-10 d=0,0,1 lambda=587.5618 vp=1,0,0 I=1 ch=3",
                  "--backward", (const char *)NULL);
     const rayline *r1, *r2;
 
@@ -784,8 +785,8 @@ static void test_backward(double forward_i2)
         double qd[3];
         CHECK(jvec(r2->text, "query_d", qd) && fabs(qd[2] - 1.0) < 1e-12,
               "backward: the depth-2 query leaves along +z");
-        CHECK_REL(r2->op, air_index(587.7247) * nbk7_d() * T_MM, 1e-14,
-                  "backward depth-2 op = n_air*n*t");
+        CHECK_REL(r2->op, nbk7_d() * T_MM, 1e-14,
+                  "backward depth-2 op = n*t");
         if (isfinite(forward_i2))
             CHECK_REL(r2->I, forward_i2, 1e-9,
                       "reciprocity: backward depth-2 I = forward depth-2 I");
@@ -874,8 +875,8 @@ static void test_modes_and_medium(void)
                       "medium 1.333, n 1.5: R");
         r2 = find_ray(&o, 2, "transmit", -1);
         if (r2)
-            CHECK_REL(r2->op, air_index(587.7247) * 1.5 * T_MM, 1e-12,
-                      "constant glass op = n_air*n*t");
+            CHECK_REL(r2->op, 1.5 * T_MM, 1e-12,
+                      "constant glass op = n*t");
         check_balance(&o, "medium");
         free(o.buf);
         proc_free(&p);
@@ -973,6 +974,115 @@ static void expect_error(const char *names, const char *what,
         expect_error(names, what, a_);                                        \
     } while (0)
 
+/* Write text to path; exits on failure (the test cannot go on). */
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f || fputs(text, f) == EOF || fclose(f) != 0) {
+        fprintf(stderr, "cannot write %s\n", path);
+        exit(1);
+    }
+}
+
+/* The output of one --ray run with ,"ray":k before the last '}' of each
+ * line, appended to buf. */
+static void append_indexed(char *buf, size_t cap, const char *out, int k)
+{
+    const char *p = out;
+    while (*p) {
+        const char *nl = strchr(p, '\n');
+        size_t len = nl ? (size_t)(nl - p) : strlen(p);
+        size_t used = strlen(buf);
+        if (len > 0 && p[len - 1] == '}')
+            snprintf(buf + used, cap - used, "%.*s,\"ray\":%d}\n",
+                     (int)(len - 1), p, k);
+        p += len + (nl ? 1 : 0);
+    }
+}
+
+/* --rays FILE: the rays of the file, in order, each exactly as --ray gives
+ * it, with its index on every line; a bad line or a ray born inside the
+ * glass fails the whole run naming FILE:LINE. */
+static void test_rays_file(void)
+{
+    static char want[1 << 16];
+    const char *path = LP_TEST_TMP "/test_lenstrace_cli.rays";
+    const char *bad = LP_TEST_TMP "/test_lenstrace_cli_bad.rays";
+    const char *r0 = "o=0,0,-10 d=0,0,1 lambda=587.5618 vp=1,0,0 I=1 ch=7";
+    const char *r1 = "o=0,3,-10 d=0,0.1,1 lambda_vac=500 vp=unpolarized ch=2";
+    char text[512];
+    proc p, q0, q1;
+
+    snprintf(text, sizeof text, "# a fan of two rays\n%s\n\n   %s\r\n", r0, r1);
+    write_text(path, text);
+    p = run("--lens", LENS, "--rays", path, (const char *)NULL);
+    q0 = run("--lens", LENS, "--ray", r0, (const char *)NULL);
+    q1 = run("--lens", LENS, "--ray", r1, (const char *)NULL);
+    expect_success(&p, "--rays");
+    expect_success(&q0, "--ray r0");
+    expect_success(&q1, "--ray r1");
+    want[0] = '\0';
+    append_indexed(want, sizeof want, q0.out, 0);
+    append_indexed(want, sizeof want, q1.out, 1);
+    CHECK(strlen(q0.out) > 100 && strcmp(p.out, want) == 0,
+          "--rays: each ray's lines as --ray gives them, with \"ray\":k:\n"
+          "got:\n%.600s\nwant:\n%.600s", p.out, want);
+    proc_free(&p);
+    proc_free(&q0);
+    proc_free(&q1);
+
+    snprintf(text, sizeof text, "%s\n%s\nthis is no ray\n", r0, r1);
+    write_text(bad, text);
+    BAD("_bad.rays:3", "--rays: a bad line", "--lens", LENS, "--rays", bad);
+    snprintf(text, sizeof text, "%s\no=0,0,1 d=0,0,1\n", r0);
+    write_text(bad, text);
+    BAD("_bad.rays:2: the origin 0,0,1 lies inside the glass",
+        "--rays: an origin inside the glass", "--lens", LENS, "--rays", bad);
+    BAD("inside the glass", "--ray: an origin inside the glass", "--lens",
+        LENS, "--ray", "o=0,0,2.5 d=1,0,0");
+    BAD("inside the glass", "--backward: an origin inside the glass",
+        "--lens", LENS, "--ray", "o=0,1,2.5 d=0,0,1", "--backward");
+    BAD("not both", "--ray and --rays", "--lens", LENS, "--ray", r0,
+        "--rays", path);
+    BAD("<stdin> holds no ray spec", "--rays - on an empty standard input",
+        "--lens", LENS, "--rays", "-");
+    BAD("no-such.rays", "--rays: a missing file", "--lens", LENS, "--rays",
+        LP_TEST_TMP "/no-such.rays");
+}
+
+/* lambda= is in standard air, lambda_vac= in vacuum: the same light given
+ * both ways traces the same, and lambda is always printed in air. */
+static void test_wavelength_convention(void)
+{
+    static output o;
+    const double vac = 587.7247;
+    const double air = vac / air_index(vac);
+    proc p = run("--lens", LENS, "--ray",
+                 "o=0,0,-10 d=0,0,1 lambda_vac=587.7247 vp=1,0,0 I=1 ch=7",
+                 (const char *)NULL);
+    const rayline *r2;
+    expect_success(&p, "lambda_vac");
+    parse_output(&p, &o, "lambda_vac");
+    for (size_t i = 0; i < o.n; i++)
+        /* Edlen's formula written here against the library's: the two
+           agree to rounding (measured 0 difference). */
+        CHECK_REL(o.rays[i].lambda, air, 1e-15,
+                  "lambda_vac=587.7247: printed lambda is in air (%.17g)",
+                  o.rays[i].lambda);
+    r2 = find_ray(&o, 2, "transmit", -1);
+    CHECK(r2 != NULL, "lambda_vac: a depth-2 transmit ray");
+    if (r2)
+        /* Traced at 587.7247 / n_air: Sellmeier there, rounding only. */
+        CHECK_REL(r2->op, nbk7_index(air) * T_MM, 1e-14,
+                  "lambda_vac: op = n(lambda_vac / n_air) * t");
+    free(o.buf);
+    proc_free(&p);
+    BAD("not both", "lambda and lambda_vac", "--lens", LENS, "--ray",
+        "o=0,0,-10 d=0,0,1 lambda=587.56 lambda_vac=587.72");
+    BAD("lambda_vac", "lambda_vac below Edlen's range", "--lens", LENS,
+        "--ray", "o=0,0,-10 d=0,0,1 lambda_vac=100");
+}
+
 static void test_errors(void)
 {
     const char *L = LENS;
@@ -1046,5 +1156,7 @@ int main(void)
     test_catalog();
     test_help_version();
     test_errors();
+    test_wavelength_convention();
+    test_rays_file();
     return check_finish("test_lenstrace_cli");
 }

@@ -1,5 +1,5 @@
 /* test_pov_compare.c -- our renderer against the real POV-Ray 3.7, scene
- * by scene (docs: shared/design/interfaces.md, "pov_compare").
+ * by scene (docs/interfaces.md, "pov_compare").
  *
  *   - the harness's own measures on synthetic inputs: identical images
  *     give an infinite PSNR and SSIM 1; a disc shifted by one pixel gives

@@ -502,9 +502,80 @@ static void test_errors(void)
     }
 }
 
+/* Focal blur: aperture rays start on the lens disk (radius aperture/2,
+ * perpendicular to D, centred on the location) and all pass through the
+ * pixel's point in focus, location + F dir with F = |focal_point -
+ * location|; a pinhole's one ray is the primary ray. */
+static void test_aperture(void)
+{
+    rs_camera c = pov_default();
+    rs_view v;
+    lp_vec3 o0, d0, o, d;
+    c.location = v3(1, 2, 3);
+    c.focal_point = v3(1, 2, 13);
+    c.aperture = 2.0;
+    c.blur_samples = 9;
+    CHECK(setup(&c, 320, 240, &v) == 0, "aperture camera sets up");
+    CHECK(v.samples == 9, "blur_samples 9: %d rays", v.samples);
+    CHECK_ABS(v.focal_distance, 10.0, 1e-15, "focal distance");
+    rs_camera_ray(&v, 40.5, 200.5, 320, 240, &o0, &d0);
+    lp_vec3 focus = v3(o0.x + 10.0 * d0.x, o0.y + 10.0 * d0.y, o0.z + 10.0 * d0.z);
+    double rmax = 0.0;
+    for (int k = 0; k < v.samples; k++) {
+        rs_camera_aperture_ray(&v, 40.5, 200.5, 320, 240, k, &o, &d);
+        lp_vec3 a = v3(o.x - c.location.x, o.y - c.location.y, o.z - c.location.z);
+        double r = sqrt(dot(a, a));
+        rmax = fmax(rmax, r);
+        CHECK(r <= 1.0 + 1e-15, "ray %d starts on the disk (r = %g)", k, r);
+        CHECK_ABS(a.z, 0.0, 1e-15, "ray %d: the disk is perpendicular to D", k);
+        CHECK_ABS(dot(d, d), 1.0, 1e-15, "ray %d: unit direction", k);
+        /* the point in focus lies on the ray */
+        lp_vec3 f = v3(focus.x - o.x, focus.y - o.y, focus.z - o.z);
+        double along = dot(f, d);
+        lp_vec3 off = v3(f.x - along * d.x, f.y - along * d.y, f.z - along * d.z);
+        CHECK_ABS(sqrt(dot(off, off)), 0.0, 1e-13, "ray %d passes the point in focus", k);
+    }
+    /* the sunflower's outermost point is at radius sqrt((N - 1/2)/N) */
+    CHECK_ABS(rmax, sqrt(8.5 / 9.0), 1e-15, "outermost aperture point");
+
+    /* the focal point moves with the camera */
+    c.xf.t[2] = 5.0;
+    c.xf.inv_t[2] = -5.0;
+    c.has_xf = 1;
+    CHECK(setup(&c, 320, 240, &v) == 0, "translated aperture camera sets up");
+    CHECK_ABS(v.focal_distance, 10.0, 1e-15, "focal distance after translate");
+    c.xf.t[2] = 0.0;
+    c.xf.inv_t[2] = 0.0;
+    c.has_xf = 0;
+
+    /* default sample count */
+    c.blur_samples = 0;
+    CHECK(setup(&c, 320, 240, &v) == 0 && v.samples == RS_CAMERA_BLUR_SAMPLES,
+          "default blur_samples");
+
+    /* a pinhole: one ray, the primary one */
+    c = pov_default();
+    CHECK(setup(&c, 320, 240, &v) == 0 && v.samples == 1, "pinhole: one ray");
+    rs_camera_ray(&v, 10.5, 20.5, 320, 240, &o0, &d0);
+    rs_camera_aperture_ray(&v, 10.5, 20.5, 320, 240, 0, &o, &d);
+    CHECK_VEC(o, o0, 0.0, "pinhole aperture ray: origin");
+    CHECK_VEC(d, d0, 0.0, "pinhole aperture ray: direction");
+
+    c.aperture = -1.0;
+    expect_error(&c, 320, 240, "negative aperture");
+    c.aperture = NAN;
+    expect_error(&c, 320, 240, "aperture NaN");
+    c.aperture = 1.0; /* focal_point <0,0,0> = location */
+    expect_error(&c, 320, 240, "aperture with the focal point at the location");
+    c = pov_default();
+    c.blur_samples = -3;
+    expect_error(&c, 320, 240, "negative blur_samples");
+}
+
 int main(void)
 {
     test_scene_defaults();
+    test_aperture();
     test_default();
     test_look_at_angle();
     test_angle_only();

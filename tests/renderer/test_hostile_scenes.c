@@ -1,6 +1,6 @@
 /* test_hostile_scenes.c -- malformed and hostile input to the scene parser
  * and to lensrender: a clear error naming a place, never a crash, a hang
- * or unbounded memory (issue 5, item 3).
+ * or unbounded memory.
  *
  *   - every input kept in tests/regressions/scene/ (found by fuzz/fuzz_scene
  *     or by review) is parsed again, from a string and from its file: it

@@ -1,5 +1,5 @@
 /* test_lensrender_cli.c -- runs the built lensrender binary and checks its
- * contract (docs: shared/design/interfaces.md, "lensrender"):
+ * contract (docs/interfaces.md, "lensrender"):
  *   - the image does not depend on --threads: --threads 1 and --threads 2
  *     give byte-identical PFM (and PNG) files for scenes/default.scene;
  *   - the PNG is a well-formed 8-bit RGB PNG (signature, chunk CRCs, IHDR

@@ -558,6 +558,27 @@ static void test_light_coherence(void)
                  "the coherence length must not be negative");
 }
 
+static void test_camera_focus(void)
+{
+    rs_scene s;
+    char msg[512];
+    CHECK(parse("camera { location <0, 0, -5> aperture 0.5 * 2 blur_samples 7\n"
+                "         focal_point <1, 2, 3> }", &s, msg, sizeof msg) == 0,
+          "focal blur: %s", msg);
+    CHECK_ABS(s.camera.aperture, 1.0, 0, "aperture 0.5 * 2");
+    CHECK(s.camera.blur_samples == 7, "blur_samples 7");
+    check_vec(s.camera.focal_point, 1, 2, 3, 0, "focal_point");
+    rs_scene_free(&s);
+    CHECK(parse("camera { }", &s, msg, sizeof msg) == 0, "camera: %s", msg);
+    CHECK(s.camera.aperture == 0.0 && s.camera.blur_samples == 0, "a pinhole by default");
+    check_vec(s.camera.focal_point, 0, 0, 0, 0, "focal_point <0,0,0> by default");
+    rs_scene_free(&s);
+    expect_error("camera { aperture -1 }", 1, 19, "the aperture must be a finite size >= 0");
+    expect_error("camera { blur_samples 0 }", 1, 23, "blur_samples must be between 1 and 4096");
+    expect_error("camera { blur_samples 5000 }", 1, 23, "blur_samples must be between 1 and 4096");
+    expect_error("camera { focus 1 }", 1, 10, "focal_point, aperture, blur_samples");
+}
+
 static void test_image_size(void)
 {
     static const char text[] = "camera { right x*image_width/image_height up y*image_height }";
@@ -1234,6 +1255,7 @@ int main(void)
     test_object_transforms();
     test_lens_folding();
     test_light_coherence();
+    test_camera_focus();
     test_image_size();
     test_errors();
     test_prepare_errors();

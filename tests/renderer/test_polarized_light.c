@@ -31,8 +31,7 @@
 
 #include "check.h"
 #include "integrator.h"
-#include "parser.h"
-#include "scene.h"
+#include "one_pixel.h"
 
 #define PI 3.14159265358979323846
 #define TOL 1e-14
@@ -43,37 +42,13 @@ static double worst;
  * three are checked equal: white light on white). */
 static int render_pixel(const char *text, rs_mode mode, double *out)
 {
-    char msg[512] = "";
-    rs_scene sc;
-    rs_parse_opts po;
-    rs_render_opts o;
-    rs_integrator *it = NULL;
-    int rc = -1;
-    rs_scene_init(&sc);
-    rs_parse_opts_init(&po);
-    po.image_width = po.image_height = 1;
-    rs_render_opts_init(&o);
-    o.mode = mode;
-    o.width = o.height = 1;
-    if (rs_parse_string(text, "<test>", &po, &sc, msg, sizeof msg) == 0 &&
-        rs_scene_prepare(&sc, msg, sizeof msg) == 0 &&
-        rs_integrator_create(&sc, &o, &it, msg, sizeof msg) == 0) {
-        rs_worker *w = rs_worker_create(it);
-        if (w != NULL) {
-            rs_color c;
-            rs_integrator_pixel(it, w, 0, 0, &c);
-            CHECK(fabs(c.r - c.g) <= 1e-12 * c.g && fabs(c.b - c.g) <= 1e-12 * c.g,
-                  "white light on white stays grey (%g %g %g)", c.r, c.g, c.b);
-            *out = c.g;
-            rs_worker_destroy(w);
-            rc = 0;
-        }
-        rs_integrator_destroy(it);
-    }
-    if (rc != 0)
-        fprintf(stderr, "render_pixel: %s\n", msg);
-    rs_scene_free(&sc);
-    return rc;
+    rs_color c;
+    if (one_pixel(text, mode, 0, &c) != 0)
+        return -1;
+    CHECK(fabs(c.r - c.g) <= 1e-12 * c.g && fabs(c.b - c.g) <= 1e-12 * c.g,
+          "white light on white stays grey (%g %g %g)", c.r, c.g, c.b);
+    *out = c.g;
+    return 0;
 }
 
 static void check_ratio(const char *what, rs_mode mode, const char *text, double base,

@@ -53,110 +53,11 @@
 
 #include "check.h"
 #include "integrator.h"
-#include "parser.h"
+#include "render_check.h"
 #include "scene.h"
 #include "support/colorimetry.h"
-#include "support/tiles.h"
 
 #define PI 3.14159265358979323846
-
-/* ---- rendering helpers -------------------------------------------------- */
-
-typedef struct picture {
-    int w, h;
-    double *rgb; /* 3 per pixel, row-major from the top */
-} picture;
-
-typedef struct job {
-    const rs_integrator *it;
-    picture *pic;
-    const unsigned char *mask; /* NULL: every pixel */
-} job;
-
-static void *job_worker_make(void *user)
-{
-    const job *j = user;
-    return rs_worker_create(j->it);
-}
-
-static void job_worker_free(void *w)
-{
-    rs_worker_destroy(w);
-}
-
-static void job_tile(void *user, void *worker, int x0, int y0, int x1, int y1)
-{
-    const job *jb = user;
-    for (int j = y0; j < y1; j++)
-        for (int i = x0; i < x1; i++) {
-            size_t k = (size_t)j * (size_t)jb->pic->w + (size_t)i;
-            rs_color c = {0, 0, 0};
-            if (!jb->mask || jb->mask[k])
-                rs_integrator_pixel(jb->it, worker, i, j, &c);
-            jb->pic->rgb[3 * k + 0] = c.r;
-            jb->pic->rgb[3 * k + 1] = c.g;
-            jb->pic->rgb[3 * k + 2] = c.b;
-        }
-}
-
-/* Parse text (or the file at path when text is NULL) into sc, which the
- * caller has set up with rs_scene_init and releases with rs_scene_free. */
-static int load_scene(rs_scene *sc, const char *text, const char *path, int w, int h)
-{
-    char msg[1024] = "";
-    rs_parse_opts po;
-    rs_parse_opts_init(&po);
-    po.image_width = w;
-    po.image_height = h;
-    int rc = text ? rs_parse_string(text, "<test>", &po, sc, msg, sizeof msg)
-                  : rs_parse_file(path, &po, sc, msg, sizeof msg);
-    if (rc != 0 || rs_scene_prepare(sc, msg, sizeof msg) != 0) {
-        fprintf(stderr, "scene: %s\n", msg);
-        return -1;
-    }
-    return 0;
-}
-
-/* Render (the masked pixels of) a w x h picture of sc.  depth <= 0 and
- * cutoff < 0 take the scene's settings. */
-static int render(const rs_scene *sc, rs_mode mode, int w, int h, int depth, double cutoff,
-                  int wavelengths, const unsigned char *mask, picture *pic)
-{
-    char msg[1024] = "";
-    rs_render_opts o;
-    rs_integrator *it = NULL;
-    rs_render_opts_init(&o);
-    o.mode = mode;
-    o.width = w;
-    o.height = h;
-    o.depth = depth;
-    o.cutoff = cutoff;
-    if (wavelengths > 0)
-        o.wavelengths = wavelengths;
-    pic->w = w;
-    pic->h = h;
-    pic->rgb = calloc((size_t)3 * (size_t)w * (size_t)h, sizeof *pic->rgb);
-    if (!pic->rgb)
-        return -1;
-    if (rs_integrator_create(sc, &o, &it, msg, sizeof msg) != 0) {
-        fprintf(stderr, "integrator: %s\n", msg);
-        return -1;
-    }
-    job jb = {it, pic, mask};
-    int rc = rs_render_tiles(w, h, 16, 2, job_worker_make, job_worker_free, job_tile, &jb, -1);
-    rs_integrator_destroy(it);
-    return rc;
-}
-
-static double px(const picture *p, int i, int j, int c)
-{
-    return p->rgb[3 * ((size_t)j * (size_t)p->w + (size_t)i) + (size_t)c];
-}
-
-static double luminance_at(const picture *p, int i, int j)
-{
-    return 0.2126 * px(p, i, j, 0) + 0.7152 * px(p, i, j, 1) + 0.0722 * px(p, i, j, 2);
-}
 
 /* The direction of pixel (i, j) of a square-pixel camera looking along +z
  * (right = x * w/h, up = y, |D| = |right| / (2 tan(angle/2)), POV-Ray's
@@ -270,13 +171,13 @@ static void test_plate_case(const char *lens, const char *what, rs_mode mode, in
     picture pw = {0, 0, NULL}, pn = {0, 0, NULL};
 
     snprintf(text, sizeof text, plate_scene_fmt, PLATE_ANGLE, lens);
-    int ok = load_scene(&with, text, NULL, PLATE_W, PLATE_H) == 0;
+    int ok = rc_load_scene(&with, text, NULL, PLATE_W, PLATE_H) == 0;
     snprintf(text, sizeof text, plate_scene_fmt, PLATE_ANGLE, "");
-    ok = ok && load_scene(&without, text, NULL, PLATE_W, PLATE_H) == 0;
+    ok = ok && rc_load_scene(&without, text, NULL, PLATE_W, PLATE_H) == 0;
     CHECK(ok, "%s: scenes load", what);
     if (ok) {
-        ok = render(&with, mode, PLATE_W, PLATE_H, 0, 1e-15, 0, NULL, &pw) == 0 &&
-             render(&without, mode, PLATE_W, PLATE_H, 0, 1e-15, 0, NULL, &pn) == 0;
+        ok = rc_render(&with, mode, PLATE_W, PLATE_H, 0, 1e-15, 0, NULL, &pw) == 0 &&
+             rc_render(&without, mode, PLATE_W, PLATE_H, 0, 1e-15, 0, NULL, &pn) == 0;
         CHECK(ok, "%s: renders", what);
     }
     if (ok) {
@@ -289,9 +190,9 @@ static void test_plate_case(const char *lens, const char *what, rs_mode mode, in
                 camera_dir_z(PLATE_ANGLE, PLATE_W, PLATE_H, i, j, d);
                 for (int c = 0; c < 3; c++) {
                     double n = sellmeier_glass ? sellmeier(BK7, RS_RGB_LAMBDA[c]) : 1.5168;
-                    double bg = px(&pn, i, j, c);
+                    double bg = rc_px(&pn, i, j, c);
                     double want = bg * plate_expected(mode, n, fabs(nx * d[0] + nz * d[2]));
-                    double got = px(&pw, i, j, c);
+                    double got = rc_px(&pw, i, j, c);
                     CHECK(bg > 0.5, "%s: background pixel (%d,%d) ch %d is lit: %g", what, i, j,
                           c, bg);
                     CHECK_REL(got, want, PLATE_TOL, "%s: pixel (%d,%d) ch %d", what, i, j, c);
@@ -358,14 +259,11 @@ static double nr_radius(int i, int j, double n)
 
 /* The scene file's set-up moved as a whole by S (camera, light, lenses,
  * ceiling): physics does not know where the world origin is, so the same
- * rings must come out.  (At the time of writing they do not: the
- * integrator gives light leaving a diffuse surface toward -d the phase of
- * a plane wave with zero phase at the world ORIGIN, op = -d.o; the two
- * film reflections leave the lens in directions 2r/R apart, so their path
- * difference becomes 2h - 2 r (r - S)/R = S^2/R - (r - S)^2/R instead of
- * 2h = r^2/R: rings centred on the world origin, not on the contact
- * point.  In the scene file the two coincide, and |-r^2/R| = 2h gives the
- * right radii up to the lateral offsets in the 4 mm of glass: +0.65 %.) */
+ * rings must come out.  (A phase model that referred the light leaving
+ * the ceiling to a plane wave through the world origin once put the
+ * rings' centre at the origin instead of the contact point; one that took
+ * a plane wavefront per pixel perpendicular to the camera ray made the
+ * radii grow with the glass above the film, +0.54 % here.) */
 static const char *nr_shifted_fmt =
     "#declare S = <%g, 0, %g>;\n"
     "global_settings { max_trace_level 8 adc_bailout 0.0001 }\n"
@@ -399,7 +297,7 @@ static void test_newtons_rings(double sx, double sz)
     if (shifted)
         snprintf(tag, sizeof tag, " (set-up moved by <%g,0,%g>)", sx, sz);
     int ok = mask && r2 && sum && sum_r2 && cnt &&
-             load_scene(&sc, shifted ? text : NULL, path, NR_SIZE, NR_SIZE) == 0;
+             rc_load_scene(&sc, shifted ? text : NULL, path, NR_SIZE, NR_SIZE) == 0;
     CHECK(ok, "newtons_rings.scene loads");
     printf("newton: %s\n", shifted ? "the set-up moved as a whole" : "scenes/newtons_rings.scene");
     if (shifted)
@@ -419,7 +317,7 @@ static void test_newtons_rings(double sx, double sz)
     /* Few continuum samples: only the sodium line lights the scene, the
      * continuum bands see black (no ambient, black background).  (4, not
      * 1: the integrator refuses 1 and 2 -- "singular colour quadrature".) */
-    ok = render(&sc, RS_MODE_POLARIZED, NR_SIZE, NR_SIZE, 0, -1.0, 4, mask, &pic) == 0;
+    ok = rc_render(&sc, RS_MODE_POLARIZED, NR_SIZE, NR_SIZE, 0, -1.0, 4, mask, &pic) == 0;
     CHECK(ok, "newtons_rings renders");
     if (!ok)
         goto out;
@@ -435,7 +333,7 @@ static void test_newtons_rings(double sx, double sz)
             int b = (int)(r2[k] / NR_BIN);
             if (b >= nb)
                 continue;
-            sum[b] += luminance_at(&pic, i, j);
+            sum[b] += rc_luminance(&pic, i, j);
             sum_r2[b] += r2[k];
             cnt[b]++;
         }
@@ -468,32 +366,9 @@ static void test_newtons_rings(double sx, double sz)
                 is_min = 0;
         if (!is_min)
             continue;
-        /* fit y = a + b t + c t^2, t = x - x[k], over k-5..k+5 */
-        double s[5] = {0}, sy[3] = {0};
-        for (int q = k - 5; q <= k + 5; q++) {
-            double t = x[q] - x[k], tp = 1.0;
-            for (int e = 0; e < 5; e++) {
-                s[e] += tp;
-                if (e < 3)
-                    sy[e] += tp * prof[q];
-                tp *= t;
-            }
-        }
-        /* normal equations, 3x3, solved by Cramer's rule */
-        double m[3][3] = {{s[0], s[1], s[2]}, {s[1], s[2], s[3]}, {s[2], s[3], s[4]}};
-        double det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                     m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                     m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-        double db = m[0][0] * (sy[1] * m[2][2] - m[1][2] * sy[2]) -
-                    sy[0] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                    m[0][2] * (m[1][0] * sy[2] - sy[1] * m[2][0]);
-        double dc = m[0][0] * (m[1][1] * sy[2] - sy[1] * m[2][1]) -
-                    m[0][1] * (m[1][0] * sy[2] - sy[1] * m[2][0]) +
-                    sy[0] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-        double bb = db / det, cc = dc / det;
-        double xm = x[k];
-        if (cc > 0.0 && fabs(bb / (2.0 * cc)) < 5.0 * NR_BIN)
-            xm = x[k] - bb / (2.0 * cc);
+        double xm = x[k], xv;
+        if (rc_parabola_min(x + k - 5, prof + k - 5, 11, &xv, NULL) == 0 && fabs(xv - x[k]) < 5.0 * NR_BIN)
+            xm = xv;
         printf("newton: minimum %d at r^2 = %.4f mm^2, %.3f of the peak\n", found + 1, xm,
                prof[k] / peak);
         rmin[found] = prof[k];
@@ -532,7 +407,12 @@ static void test_newtons_rings(double sx, double sz)
         double want = sqrt(m * NR_LAMBDA * 1e-6 * NR_R);
         printf("newton: dark ring m=%d  r = %.4f mm  theory %.4f mm  error %+.3f %%\n", m,
                rm[m - 1], want, 100.0 * (rm[m - 1] - want) / want);
-        CHECK_REL(rm[m - 1], want, 0.02, "newton%s: dark ring m=%d radius", tag, m);
+        /* Measured +0.001 .. +0.003 % (rings 1..5, both set-ups): the
+         * sub-pixel fit on bins of r^2 (the pixel's chief ray, used to map
+         * it to the film, neglects the film's own 1.5 um).  Checked at
+         * 0.05 %, ten times under the +0.54 % of the per-pixel plane
+         * wavefront above. */
+        CHECK_REL(rm[m - 1], want, 5e-4, "newton%s: dark ring m=%d radius", tag, m);
     }
 out:
     free(pic.rgb);
@@ -601,15 +481,15 @@ static void test_crossed_no_lens(void)
     CHECK(bound < 1e-3, "crossed: the leak bound %g is below the 1e-3 tolerance", bound);
 
     snprintf(text, sizeof text, xp_scene_fmt, xp_polarizers);
-    int ok = load_scene(&sp, text, NULL, XP_SIZE, XP_SIZE) == 0;
+    int ok = rc_load_scene(&sp, text, NULL, XP_SIZE, XP_SIZE) == 0;
     snprintf(text, sizeof text, xp_scene_fmt, "");
-    ok = ok && load_scene(&sb, text, NULL, XP_SIZE, XP_SIZE) == 0;
+    ok = ok && rc_load_scene(&sb, text, NULL, XP_SIZE, XP_SIZE) == 0;
     CHECK(ok, "crossed polarizers: scenes load");
     if (!ok)
         goto out;
-    ok = render(&sp, RS_MODE_POLARIZED, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pp) == 0 &&
-         render(&sp, RS_MODE_FRESNEL, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pf) == 0 &&
-         render(&sb, RS_MODE_POLARIZED, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pb) == 0;
+    ok = rc_render(&sp, RS_MODE_POLARIZED, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pp) == 0 &&
+         rc_render(&sp, RS_MODE_FRESNEL, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pf) == 0 &&
+         rc_render(&sb, RS_MODE_POLARIZED, XP_SIZE, XP_SIZE, 0, -1.0, 0, NULL, &pb) == 0;
     CHECK(ok, "crossed polarizers: renders");
     if (!ok)
         goto out;
@@ -622,7 +502,7 @@ static void test_crossed_no_lens(void)
             camera_dir_z(XP_ANGLE, XP_SIZE, XP_SIZE, i, j, d);
             double leak = crossed_leak(d);
             for (int c = 0; c < 3; c++) {
-                double box = px(&pb, i, j, c), got = px(&pp, i, j, c);
+                double box = rc_px(&pb, i, j, c), got = rc_px(&pp, i, j, c);
                 if (box > 0.5 * XP_BOX)
                     lit++;
                 /* c. black: below 1e-3 of the box everywhere */
@@ -636,7 +516,7 @@ static void test_crossed_no_lens(void)
                 if (box > 0.0 && leak > 0.0 && fabs(got - box * leak) / (box * leak) > worst_model)
                     worst_model = fabs(got - box * leak) / (box * leak);
                 /* d. the unpolarized model: 1/2 * 1/2 of the box */
-                double f = px(&pf, i, j, c);
+                double f = rc_px(&pf, i, j, c);
                 CHECK_ABS(f, 0.25 * box, 1e-9 * XP_BOX,
                           "crossed, fresnel: pixel (%d,%d) ch %d is box/4", i, j, c);
                 if (box > 0.5 * XP_BOX && fabs(f / box - 0.25) > worst_quarter)
@@ -729,11 +609,11 @@ static void test_crossed_lens(void)
     const int N = XP_SIZE, c0 = XP_SIZE / 2;
 
     snprintf(path, sizeof path, "%s/scenes/crossed_polarizers.scene", LP_SOURCE_DIR);
-    int ok = load_scene(&sc, NULL, path, N, N) == 0;
+    int ok = rc_load_scene(&sc, NULL, path, N, N) == 0;
     CHECK(ok, "crossed_polarizers.scene loads");
     if (!ok)
         goto out;
-    ok = render(&sc, RS_MODE_POLARIZED, N, N, 0, -1.0, 0, NULL, &p) == 0;
+    ok = rc_render(&sc, RS_MODE_POLARIZED, N, N, 0, -1.0, 0, NULL, &p) == 0;
     CHECK(ok, "crossed_polarizers.scene renders");
     if (!ok)
         goto out;
@@ -745,12 +625,12 @@ static void test_crossed_lens(void)
     double vmax = 0.0, worst_sym = 0.0;
     for (int j = 0; j < N; j++)
         for (int i = 0; i < N; i++)
-            vmax = fmax(vmax, luminance_at(&p, i, j));
+            vmax = fmax(vmax, rc_luminance(&p, i, j));
     for (int j = 0; j < N; j++)
         for (int i = 0; i < N; i++)
             for (int c = 0; c < 3; c++) {
-                double v = px(&p, i, j, c);
-                double other[2] = {px(&p, N - 1 - i, j, c), px(&p, i, N - 1 - j, c)};
+                double v = rc_px(&p, i, j, c);
+                double other[2] = {rc_px(&p, N - 1 - i, j, c), rc_px(&p, i, N - 1 - j, c)};
                 static const char *const name[2] = {"x-mirror", "y-mirror"};
                 for (int s = 0; s < 2; s++) {
                     double big = fmax(fabs(v), fabs(other[s]));
@@ -767,8 +647,8 @@ static void test_crossed_lens(void)
      * polarization). */
     double diag_max = 0.0, axis_max = 0.0;
     for (int k = 0; k < N; k++) {
-        diag_max = fmax(diag_max, fmax(luminance_at(&p, k, k), luminance_at(&p, k, N - 1 - k)));
-        axis_max = fmax(axis_max, fmax(luminance_at(&p, k, c0), luminance_at(&p, c0, k)));
+        diag_max = fmax(diag_max, fmax(rc_luminance(&p, k, k), rc_luminance(&p, k, N - 1 - k)));
+        axis_max = fmax(axis_max, fmax(rc_luminance(&p, k, c0), rc_luminance(&p, c0, k)));
     }
     {
         double dl = 1.0 / (2.0 * tan(XP_ANGLE * PI / 360.0)), nn = sqrt(0.5 + dl * dl);
@@ -786,7 +666,7 @@ static void test_crossed_lens(void)
     double worst_transpose = 1.0, sb_eff = 0.0;
     for (int b = -c0; b <= c0; b++)
         for (int a = -c0; a <= c0; a++) {
-            double l1 = luminance_at(&p, c0 + a, c0 - b), l2 = luminance_at(&p, c0 + b, c0 - a);
+            double l1 = rc_luminance(&p, c0 + a, c0 - b), l2 = rc_luminance(&p, c0 + b, c0 - a);
             if (a == 0 || b == 0 || a == b || a == -b || l1 < 1e-3 * vmax)
                 continue;
             double d[3], lo, hi, phi = atan2((double)b, (double)a);
@@ -815,7 +695,7 @@ static void test_crossed_lens(void)
     for (size_t q = 0; q < sizeof pairs / sizeof *pairs; q++) {
         int a = pairs[q][0], b = pairs[q][1], e = pairs[q][2], f = pairs[q][3];
         double phi1 = atan2((double)b, (double)a), phi2 = atan2((double)f, (double)e);
-        double l1 = luminance_at(&p, c0 + a, c0 - b), l2 = luminance_at(&p, c0 + e, c0 - f);
+        double l1 = rc_luminance(&p, c0 + a, c0 - b), l2 = rc_luminance(&p, c0 + e, c0 - f);
         double d[3], lo, hi;
         camera_dir_z(XP_ANGLE, N, N, c0 + a, c0 - b, d);
         CHECK(l1 > l2, "lens leak: (%d,%d) nearer the diagonal is brighter than (%d,%d): %g vs %g",
@@ -899,7 +779,7 @@ static void test_rim_shadow(void)
     unsigned char mask[RS_W * RS_H];
 
     rs_scene_init(&sc);
-    if (load_scene(&sc, rim_shadow_scene, NULL, RS_W, RS_H) != 0) {
+    if (rc_load_scene(&sc, rim_shadow_scene, NULL, RS_W, RS_H) != 0) {
         CHECK(0, "rim shadow scene");
         goto out;
     }
@@ -913,7 +793,7 @@ static void test_rim_shadow(void)
             r1 = hypot(d[0] * 65.0, d[1] * 65.0);
             mask[j * RS_W + i] = r0 > RS_RIM_R + 0.5 && r1 > RS_RIM_R + 0.5;
         }
-    if (render(&sc, RS_MODE_FRESNEL, RS_W, RS_H, 0, 0.0, 4, mask, &p) != 0) {
+    if (rc_render(&sc, RS_MODE_FRESNEL, RS_W, RS_H, 0, 0.0, 4, mask, &p) != 0) {
         CHECK(0, "rim shadow render");
         goto out;
     }
@@ -939,7 +819,7 @@ static void test_rim_shadow(void)
                 dark++;
                 through_cap += hypot(xb, yb) < RS_RIM_R;
             }
-            if ((luminance_at(&p, i, j) > 0.0) == expect)
+            if ((rc_luminance(&p, i, j) > 0.0) == expect)
                 wrong++;
         }
     /* Measured: 5752 wall pixels called, 377 dark, 282 of them reached

@@ -35,8 +35,7 @@
 #include "check.h"
 #include "emitter.h"
 #include "integrator.h"
-#include "parser.h"
-#include "scene.h"
+#include "one_pixel.h"
 
 static rs_color rgb(double r, double g, double b)
 {
@@ -386,38 +385,6 @@ static double colour_condition(int n)
     }
     return nc * na;
 }
-static int render_one_pixel(const char *text, rs_mode mode, int n, rs_color *out)
-{
-    char msg[512] = "";
-    rs_scene sc;
-    rs_parse_opts po;
-    rs_render_opts o;
-    rs_integrator *it = NULL;
-    int rc = -1;
-    rs_scene_init(&sc);
-    rs_parse_opts_init(&po);
-    po.image_width = po.image_height = 1;
-    rs_render_opts_init(&o);
-    o.mode = mode;
-    o.wavelengths = n;
-    o.width = o.height = 1;
-    if (rs_parse_string(text, "<test>", &po, &sc, msg, sizeof msg) == 0 &&
-        rs_scene_prepare(&sc, msg, sizeof msg) == 0 &&
-        rs_integrator_create(&sc, &o, &it, msg, sizeof msg) == 0) {
-        rs_worker *w = rs_worker_create(it);
-        if (w != NULL) {
-            rs_integrator_pixel(it, w, 0, 0, out);
-            rs_worker_destroy(w);
-            rc = 0;
-        }
-        rs_integrator_destroy(it);
-    }
-    if (rc != 0)
-        fprintf(stderr, "render_one_pixel: %s\n", msg);
-    rs_scene_free(&sc);
-    return rc;
-}
-
 static void test_colour_correction(void)
 {
     static const rs_color cols[] = {{1, 1, 1}, {0.8, 0.3, 0.1}, {0.2, 0.4, 0.6}, {3, 0, 0.5}};
@@ -444,7 +411,7 @@ static void test_colour_correction(void)
                          "camera { location <0,0,0> look_at <0,0,1> angle 10 }\n"
                          "background { rgb <%.17g, %.17g, %.17g> }\n",
                          want.r, want.g, want.b);
-                if (render_one_pixel(text, modes[m], n, &got) != 0) {
+                if (one_pixel(text, modes[m], n, &got) != 0) {
                     CHECK(0, "background scene renders");
                     continue;
                 }

@@ -1,0 +1,105 @@
+/* coherence.c -- the common-source-point model of coherence.h. */
+#include "coherence.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#define RS_COH_PI 3.14159265358979323846
+#define RS_COH_LOW 0xffffffffu
+
+long rs_wavelets_push(rs_wavelets *t, const rs_wavelet *w)
+{
+    if (t->n >= (size_t)RS_COH_LOW)
+        return -1;
+    if (t->n == t->cap) {
+        size_t cap = t->cap ? 2 * t->cap : 32;
+        rs_wavelet *p = realloc(t->w, cap * sizeof *p);
+        if (!p)
+            return -1;
+        t->w = p;
+        t->cap = cap;
+    }
+    t->w[t->n] = *w;
+    return (long)t->n++;
+}
+
+void rs_wavelets_free(rs_wavelets *t)
+{
+    free(t->w);
+    t->w = NULL;
+    t->n = t->cap = 0;
+}
+
+uint64_t rs_coherence_ch(long index, int source, int half)
+{
+    return ((uint64_t)index << 32) | (2u * (uint64_t)source + (uint64_t)half);
+}
+
+static double dot3(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static lp_vec3 sub3(lp_vec3 a, lp_vec3 b) { return (lp_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+
+/* The difference of the wavelets' optical paths from the pair's common
+ * source point (coherence.h); 0 with *ok = 0 when the pair has none. */
+static double wavelet_difference(const rs_wavelet *a, const rs_wavelet *b, int *ok)
+{
+    *ok = 1;
+    if (a == b)
+        return 0.0;
+    if (a->emitter != b->emitter || a->finite != b->finite) {
+        *ok = 0;
+        return 0.0;
+    }
+    lp_vec3 dab = sub3(a->o, b->o);
+    if (a->finite) {
+        /* |S - o_a| - |S - o_b| = (o_a - o_b).(o_a + o_b - 2S) / (|S - o_a| + |S - o_b|),
+         * S = (s_a + s_b)/2: no cancellation of the two long distances. */
+        lp_vec3 s = {0.5 * (a->s.x + b->s.x), 0.5 * (a->s.y + b->s.y), 0.5 * (a->s.z + b->s.z)};
+        lp_vec3 sa = sub3(s, a->o), sb = sub3(s, b->o);
+        double la = sqrt(dot3(sa, sa)), lb = sqrt(dot3(sb, sb));
+        if (!(la + lb > 0.0))
+            return 0.0;
+        lp_vec3 m = {-(sa.x + sb.x), -(sa.y + sb.y), -(sa.z + sb.z)}; /* o_a + o_b - 2S */
+        return dot3(dab, m) / (la + lb);
+    }
+    lp_vec3 u = {a->d.x + b->d.x, a->d.y + b->d.y, a->d.z + b->d.z};
+    double lu = sqrt(dot3(u, u));
+    if (!(lu > 1e-9)) { /* opposite directions: no common point at infinity */
+        *ok = 0;
+        return 0.0;
+    }
+    return -dot3(u, dab) / lu;
+}
+
+double rs_coherent_power(const lp_ray *r, size_t n, const rs_wavelets *t,
+                         const unsigned char *coherent, const double *coherence,
+                         int n_sources, double lambda_nm)
+{
+    double total = 0.0;
+    double k0 = 2.0 * RS_COH_PI / (lambda_nm * 1e-6);
+
+    for (size_t i = 0; i < n; i++) {
+        const lp_ray *a = &r[i];
+        total += a->intensity;
+        uint64_t ca = a->ch & RS_COH_LOW, src = ca / 2, ia = a->ch >> 32;
+        if (src >= (uint64_t)n_sources || !coherent[src] || a->intensity == 0.0 || ia >= t->n)
+            continue;
+        double lc = coherence[src];
+        for (size_t j = i + 1; j < n; j++) {
+            const lp_ray *b = &r[j];
+            uint64_t ib = b->ch >> 32;
+            if ((b->ch & RS_COH_LOW) != ca || b->intensity == 0.0 || ib >= t->n)
+                continue;
+            int ok;
+            double dop = a->op - b->op + wavelet_difference(&t->w[ia], &t->w[ib], &ok);
+            if (!ok)
+                continue;
+            double gamma = lc > 0.0 ? exp(-(dop / lc) * (dop / lc)) : 1.0;
+            if (gamma < 1e-12)
+                continue;
+            double dphi = k0 * dop - RS_COH_PI * (a->kphi - b->kphi) + (a->phase - b->phase);
+            double vv = dot3(a->vp, b->vp);
+            total += 2.0 * gamma * sqrt(a->intensity * b->intensity) * vv * cos(dphi);
+        }
+    }
+    return total > 0.0 ? total : 0.0;
+}

@@ -1,0 +1,27 @@
+/* cli.h -- what every command-line program of the project needs: its
+ * one-line messages, a clock, output directories (support floor).
+ *
+ * For programs only: sp_say writes to stderr, which no library does. */
+#ifndef SUPPORT_CLI_H
+#define SUPPORT_CLI_H
+
+#include <stddef.h>
+
+/* One line "PROGRAM: MESSAGE\n" on stderr, MESSAGE formatted as printf
+ * does.  Control characters in it (from user text or file names) become
+ * '?', so the message stays one line. */
+void sp_say(const char *program, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/* Seconds on the monotonic clock (for elapsed times only). */
+double sp_now_seconds(void);
+
+/* Create the directory path and its missing parents (mode 0777 before the
+ * umask).  0 when path is a directory afterwards; else -1 and a one-line
+ * message naming the directory in msg. */
+int sp_mkdir_p(const char *path, char *msg, size_t msg_size);
+
+#endif
