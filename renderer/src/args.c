@@ -107,7 +107,7 @@ static const char *int_option(rs_args *args, const char *name, const char *val,
 /* The options that take a value. */
 enum {
     OPT_OUT, OPT_WIDTH, OPT_HEIGHT, OPT_MODE, OPT_DEPTH, OPT_WAVELENGTHS,
-    OPT_THREADS, OPT_PFM, OPT_CUTOFF, OPT_AA, OPT_LIBRARY, OPT_COUNT
+    OPT_THREADS, OPT_PFM, OPT_CUTOFF, OPT_AA, OPT_LIBRARY, OPT_TOLERANCE, OPT_COUNT
 };
 
 static const struct {
@@ -127,6 +127,7 @@ static const struct {
     { "--aa", OPT_AA },
     { "--library", OPT_LIBRARY },
     { "-L", OPT_LIBRARY },
+    { "--tolerance", OPT_TOLERANCE },
 };
 
 static const char *set_value(rs_args *args, int id, const char *name,
@@ -149,6 +150,7 @@ static const char *set_value(rs_args *args, int id, const char *name,
     case OPT_DEPTH:
         return int_option(args, name, val, 1, RS_ARGS_DEPTH_MAX, &args->depth);
     case OPT_WAVELENGTHS:
+        args->wavelengths_given = 1;
         return int_option(args, name, val, 1, RS_ARGS_WAVELENGTHS_MAX,
                           &args->wavelengths);
     case OPT_THREADS:
@@ -187,6 +189,15 @@ static const char *set_value(rs_args *args, int id, const char *name,
         if (v < 0.0 || v > 1.0)
             return fail(args, "%s: %s is out of range (0..1)", name, val);
         args->cutoff = v;
+        return NULL;
+    }
+    case OPT_TOLERANCE: {
+        double v;
+        if (!parse_double(val, &v))
+            return fail(args, "%s: '%s' is not a finite number", name, val);
+        if (!(v >= 1e-6 && v <= 1.0))
+            return fail(args, "%s: %s is out of range (1e-6..1)", name, val);
+        args->tolerance = v;
         return NULL;
     }
     default:
@@ -346,6 +357,8 @@ const char *rs_args_parse(rs_args *args, int argc, char **argv)
         }
     }
 
+    if (args->tolerance > 0.0 && !args->mode_auto)
+        return fail(args, "--tolerance applies to --mode auto only");
     if (!args->scene)
         return fail(args, "no scene file given (usage: lensrender SCENE "
                     "[options]; see --help)");

@@ -4,7 +4,7 @@
  *   lensrender SCENE [-o OUT.png] [--width W] [--height H]
  *              [--mode rgb|schlick|fresnel|polarized|auto] [--depth N]
  *              [--wavelengths N] [--threads N] [--pfm OUT.pfm] [--quiet]
- *              [--cutoff F] [--aa N] [-L DIR]...
+ *              [--cutoff F] [--tolerance E] [--aa N] [-L DIR]...
  *   and POV-Ray's habits: +WW +HH +OOUT.png +A[THRESHOLD] -A +LDIR
  *   lensrender --help | --version
  *
@@ -48,8 +48,11 @@ typedef struct rs_args {
     rs_mode mode;         /* default RS_MODE_POLARIZED */
     int depth;            /* 1..256; 0 = the scene's max_trace_level */
     int wavelengths;      /* 1..1024; default 16 */
+    int wavelengths_given;/* --wavelengths was on the command line */
     int threads;          /* 1..1024; 0 = every online processor (default) */
     double cutoff;        /* 0..1; < 0 = the scene's adc_bailout (default) */
+    double tolerance;     /* --tolerance E (with --mode auto), > 0; 0 = not
+                             given */
     int quiet;            /* --quiet / -q */
     int no_dispersion;    /* --no-dispersion: every glass becomes a constant,
                              lossless index, its index at 587.56 nm (for

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "args.h"
+#include "auto_settings.h"
 #include "camera.h"
 #include "support/cli.h"
 #include "support/image.h"
@@ -30,7 +31,7 @@ static const char *const usage_text[] = {
 "usage: lensrender SCENE [-o OUT.png] [--width W] [--height H]\n"
 "                  [--mode rgb|schlick|fresnel|polarized|auto] [--depth N]\n"
 "                  [--wavelengths N] [--threads N] [--pfm OUT.pfm] [--quiet]\n"
-"                  [--cutoff F] [--aa N] [-L DIR]...\n"
+"                  [--cutoff F] [--tolerance E] [--aa N] [-L DIR]...\n"
 "       lensrender SCENE +W640 +H480 +Oout.png [+A[THRESHOLD] | -A] [+LDIR]\n"
 "       lensrender --help | --version\n"
 "\n",
@@ -53,9 +54,13 @@ static const char *const usage_text[] = {
 "                                   interface (POV-Ray's model)\n"
 "                        schlick    spectral, Schlick's approximation\n"
 "                        rgb        three colour channels, unpolarized\n"
-"                        auto       polarized when the scene has a\n"
-"                                   polarizer, a polarized light or\n"
-"                                   coherence, else fresnel\n",
+"                        auto       the model, wavelengths, depth and\n"
+"                                   cut-off that keep the error within\n"
+"                                   --tolerance at the least cost (it says\n"
+"                                   what it chose and why)\n"
+"  --tolerance E       with --mode auto: the RMSE of linear RGB allowed\n"
+"                      against a converged polarized render, 1e-6..1\n"
+"                      (default 1e-3)\n",
 "  --depth N           max trace level 1..256 (default: the scene's\n"
 "                      global_settings max_trace_level, 5 if none)\n"
 "  --wavelengths N     spectral samples per pixel, 1..1024 (default 16)\n"
@@ -87,32 +92,6 @@ static void say(const char *prefix, const char *msg)
         sp_say("lensrender", "%s: %s", prefix, msg);
     else
         sp_say("lensrender", "%s", msg);
-}
-
-/* What --mode auto picks, and why (for the message). */
-static rs_mode auto_mode(const rs_scene *s, const char **why)
-{
-    for (size_t i = 0; i < s->n_objects; i++)
-        if (s->objects[i].type == RS_OBJ_POLARIZER) {
-            *why = "the scene has a polarizer";
-            return RS_MODE_POLARIZED;
-        }
-    for (size_t k = 0; k < s->n_lights; k++)
-        if (s->lights[k].polarized) {
-            *why = "the scene has a polarized light";
-            return RS_MODE_POLARIZED;
-        }
-    if (s->settings.coherent) {
-        *why = "the scene is coherent";
-        return RS_MODE_POLARIZED;
-    }
-    for (size_t k = 0; k < s->n_lights; k++)
-        if (s->lights[k].coherent) {
-            *why = "the scene has a coherent light";
-            return RS_MODE_POLARIZED;
-        }
-    *why = "no polarizer, polarized light or coherence in the scene";
-    return RS_MODE_FRESNEL;
 }
 
 /* ---- the render: tiles of pixels into an rs_image ---------------------- */
@@ -213,15 +192,6 @@ static int run(const rs_args *a)
         status = EXIT_BAD;
         goto done;
     }
-    if (a->mode_auto) {
-        const char *why = "";
-        mode = auto_mode(&scene, &why);
-        if (!a->quiet)
-            fprintf(stderr, "lensrender: mode auto: %s (%s)\n",
-                    rs_mode_name(mode), why);
-    }
-    depth = a->depth > 0 ? a->depth : scene.settings.max_trace_level;
-
     rs_render_opts_init(&ropts);
     ropts.mode = mode;
     ropts.depth = a->depth;
@@ -230,6 +200,22 @@ static int run(const rs_args *a)
     ropts.width = a->width;
     ropts.height = a->height;
     ropts.aa = a->aa;
+    if (a->mode_auto) {
+        char why[512];
+        rs_auto_request req = {a->tolerance > 0.0 ? a->tolerance : RS_AUTO_TOLERANCE_DEFAULT,
+                               a->width, a->height, a->depth,
+                               a->wavelengths_given ? a->wavelengths : 0, a->cutoff};
+        if (rs_auto_choose(&scene, &req, &ropts, why, sizeof why, msg, sizeof msg) != 0) {
+            say(a->scene, msg);
+            status = EXIT_RENDER;
+            goto done;
+        }
+        mode = ropts.mode;
+        if (!a->quiet)
+            fprintf(stderr, "lensrender: auto: %s\n", why);
+    }
+    ropts.aa = a->aa; /* antialiasing is the user's, whatever auto chose */
+    depth = ropts.depth > 0 ? ropts.depth : scene.settings.max_trace_level;
     if (rs_integrator_create(&scene, &ropts, &it, msg, sizeof msg) != 0) {
         say(a->scene, msg);
         status = EXIT_RENDER;
@@ -272,7 +258,7 @@ static int run(const rs_args *a)
                 "lensrender: wrote %s (%d x %d, %s, %d wavelengths, depth %d) "
                 "in %.2f s\n",
                 a->out_png, a->width, a->height, rs_mode_name(mode),
-                a->wavelengths, depth, sp_now_seconds() - t0);
+                ropts.wavelengths, depth, sp_now_seconds() - t0);
 
 done:
     rs_image_free(&img);

@@ -407,4 +407,85 @@ static inline int lrefract(lv3 d, lv3 n, ref_real n1, ref_real n2, lv3 *out)
     return 1;
 }
 
+/* The internal chain of one ray through a lens, node by node, in ref_real
+ * (test_rim, test_reciprocity): the path the paper's model follows (enter,
+ * then reflect at every cap node), stopped at the rim, a miss or
+ * REF_CHAIN_MAX nodes. */
+#define REF_CHAIN_MAX 24
+typedef struct {
+    int n;                                   /* cap nodes 1..n */
+    lv3 p[REF_CHAIN_MAX + 2], nrm[REF_CHAIN_MAX + 2], din[REF_CHAIN_MAX + 2], drefl[REF_CHAIN_MAX + 2], dtran[REF_CHAIN_MAX + 2];
+    int surf[REF_CHAIN_MAX + 2], tir[REF_CHAIN_MAX + 2], good[REF_CHAIN_MAX + 2];
+    ref_real seg[REF_CHAIN_MAX + 2];                  /* internal length node k-1 -> k */
+    ref_real cosi[REF_CHAIN_MAX + 2];
+    int rim_depth;                           /* node index of the rim, 0 none */
+    lv3 rim_p;                               /* where the chain meets the rim */
+    ref_real rim_cos;                        /* |cos| of incidence on the rim */
+    int leak;
+} ref_cap_chain;
+
+/* The chain of the ray O + s d (d unit) into a lens of index ng in a medium
+ * nm.  good[k] marks a well-conditioned node: away from the cap's edge
+ * circle, not grazing, not near the critical angle. */
+static inline void ref_build_cap_chain(const ref_lens *L, ref_real ng, ref_real nm, lv3 O, lv3 d,
+                                   ref_cap_chain *c)
+{
+    memset(c, 0, sizeof *c);
+    ref_hit h = ref_intersect(L, O, d, REF(0.0));
+    if (h.surf < 0)
+        return;
+    if (h.surf == LP_SURFACE_RIM) {
+        c->rim_depth = 1;
+        c->rim_p = h.p;
+        c->rim_cos = ref_fabs(ldot(d, h.n));
+        return;
+    }
+    lv3 dir = d;
+    ref_real n1 = nm, n2 = ng;
+    ref_real edge_m = REF(1e-6) * L->size;
+    for (int k = 1; k <= REF_CHAIN_MAX; k++) {
+        c->n = k;
+        c->p[k] = h.p;
+        c->nrm[k] = h.n;
+        c->surf[k] = h.surf;
+        c->din[k] = dir;
+        ref_real ci = ref_fabs(ldot(dir, h.n));
+        c->cosi[k] = ci;
+        c->drefl[k] = lreflect(dir, h.n);
+        c->tir[k] = !lrefract(dir, h.n, n1, n2, &c->dtran[k]);
+        /* conditioning: away from the cap's edge circle, not grazing, not
+         * near the critical angle */
+        ref_real a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
+        ref_real r = ref_sqrt(h.p.x * h.p.x + h.p.y * h.p.y);
+        ref_real x = (n1 / n2) * ref_sqrt((1 - ci) * (1 + ci)); /* sin of refraction */
+        int good = r < a - edge_m && ci > REF(0.02) && ref_fabs(x - 1) > REF(1e-3);
+        if (!c->tir[k])
+            good = good && ref_sqrt((1 - x) * (1 + x)) > REF(0.02);
+        c->good[k] = good;
+        lv3 next;
+        if (k == 1) {
+            if (c->tir[1])
+                return;
+            next = c->dtran[1];
+            n1 = ng;
+            n2 = nm;
+        } else {
+            next = c->drefl[k];
+        }
+        h = ref_intersect(L, h.p, next, REF(1e-9) * L->size);
+        if (h.surf < 0) {
+            c->leak = 1;
+            return;
+        }
+        if (h.surf == LP_SURFACE_RIM) {
+            c->rim_depth = k + 1;
+            c->rim_p = h.p;
+            c->rim_cos = ref_fabs(ldot(next, h.n));
+            return;
+        }
+        c->seg[k + 1] = h.s;
+        dir = next;
+    }
+}
+
 #endif

@@ -144,79 +144,13 @@ static cv3 jones_node(cv3 E, lv3 k_in, lv3 k_out, lv3 n, ref_real n1, ref_real n
 }
 
 /* ------------------------------------------------------------------ */
-/* the view ray's chain through the lens (ref_real reference)          */
+/* the view ray's chain through the lens: ref_build_cap_chain              */
+/* (lens_reference.h)                                                  */
 /* ------------------------------------------------------------------ */
-
-#define MAXN 24
-typedef struct {
-    int n;                                   /* cap nodes 1..n */
-    lv3 p[MAXN + 2], nrm[MAXN + 2], din[MAXN + 2], drefl[MAXN + 2], dtran[MAXN + 2];
-    int surf[MAXN + 2], tir[MAXN + 2], good[MAXN + 2];
-    ref_real seg[MAXN + 2];                  /* internal length node k-1 -> k */
-    ref_real cosi[MAXN + 2];
-    int rim_depth;                           /* node index of the rim, 0 none */
-    int leak;
-} chain;
-
-static void build_chain(const ref_lens *L, ref_real ng, ref_real nm, lv3 O, lv3 d, chain *c)
-{
-    memset(c, 0, sizeof *c);
-    ref_hit h = ref_intersect(L, O, d, REF(0.0));
-    if (h.surf < 0)
-        return;
-    if (h.surf == LP_SURFACE_RIM) {
-        c->rim_depth = 1;
-        return;
-    }
-    lv3 dir = d;
-    ref_real n1 = nm, n2 = ng;
-    ref_real edge_m = REF(1e-6) * L->size;
-    for (int k = 1; k <= MAXN; k++) {
-        c->n = k;
-        c->p[k] = h.p;
-        c->nrm[k] = h.n;
-        c->surf[k] = h.surf;
-        c->din[k] = dir;
-        ref_real ci = ref_fabs(ldot(dir, h.n));
-        c->cosi[k] = ci;
-        c->drefl[k] = lreflect(dir, h.n);
-        c->tir[k] = !lrefract(dir, h.n, n1, n2, &c->dtran[k]);
-        /* conditioning: away from the cap's edge circle, not grazing, not
-         * near the critical angle */
-        ref_real a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
-        ref_real r = ref_sqrt(h.p.x * h.p.x + h.p.y * h.p.y);
-        ref_real x = (n1 / n2) * ref_sqrt((1 - ci) * (1 + ci)); /* sin of refraction */
-        int good = r < a - edge_m && ci > REF(0.02) && ref_fabs(x - 1) > REF(1e-3);
-        if (!c->tir[k])
-            good = good && ref_sqrt((1 - x) * (1 + x)) > REF(0.02);
-        c->good[k] = good;
-        lv3 next;
-        if (k == 1) {
-            if (c->tir[1])
-                return;
-            next = c->dtran[1];
-            n1 = ng;
-            n2 = nm;
-        } else {
-            next = c->drefl[k];
-        }
-        h = ref_intersect(L, h.p, next, REF(1e-9) * L->size);
-        if (h.surf < 0) {
-            c->leak = 1;
-            return;
-        }
-        if (h.surf == LP_SURFACE_RIM) {
-            c->rim_depth = k + 1;
-            return;
-        }
-        c->seg[k + 1] = h.s;
-        dir = next;
-    }
-}
 
 /* Follow light along the reverse of the chain from node k to node 1,
  * starting at S along u0; 0 if it takes another route. */
-static int follow(const ref_lens *L, const chain *c, int k, ref_real ng, ref_real nm, lv3 S,
+static int follow(const ref_lens *L, const ref_cap_chain *c, int k, ref_real ng, ref_real nm, lv3 S,
                   lv3 u0, lv3 *exit_p, lv3 *exit_d)
 {
     ref_hit h = ref_intersect(L, S, u0, REF(0.0));
@@ -247,14 +181,14 @@ static int follow(const ref_lens *L, const chain *c, int k, ref_real ng, ref_rea
 }
 
 /* optical path inside the lens along query k's path */
-static ref_real chain_op(const chain *c, int k, ref_real ng)
+static ref_real chain_op(const ref_cap_chain *c, int k, ref_real ng)
 {
     ref_real L = 0;
     for (int j = 2; j <= k; j++)
         L += c->seg[j];
     return ng * L;
 }
-static ref_real chain_len(const chain *c, int k)
+static ref_real chain_len(const ref_cap_chain *c, int k)
 {
     ref_real L = 0;
     for (int j = 2; j <= k; j++)
@@ -265,7 +199,7 @@ static ref_real chain_len(const chain *c, int k)
 /* The exact field leaving at the view ray's entry point along -d for
  * light arriving along -(query k dir) with field vp (unit, real), without
  * the propagation phase and absorption. */
-static cv3 chain_jones(const chain *c, int k, ref_real ng, ref_real nm, lv3 vp, lv3 view_d)
+static cv3 chain_jones(const ref_cap_chain *c, int k, ref_real ng, ref_real nm, lv3 vp, lv3 view_d)
 {
     cv3 E = cv_from(vp);
     if (k == 1)
@@ -279,7 +213,7 @@ static cv3 chain_jones(const chain *c, int k, ref_real ng, ref_real nm, lv3 vp, 
 
 /* unpolarized (or polarized bound) power transmittance of query k's path,
  * without absorption */
-static ref_real chain_power(const chain *c, int k, ref_real ng, ref_real nm, lp_mode mode,
+static ref_real chain_power(const ref_cap_chain *c, int k, ref_real ng, ref_real nm, lp_mode mode,
                             int bound)
 {
     ref_real P = 1;
@@ -407,8 +341,8 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
         /* the reference chain from exactly the double view ray */
         lv3 O = fl_point(&f, Ow);
         d = lnorm(fl_dir(&f, dw));
-        chain c;
-        build_chain(&L, ng, nm, O, d, &c);
+        ref_cap_chain c;
+        ref_build_cap_chain(&L, ng, nm, O, d, &c);
         lp_error err;
         lp_status stt = lp_backward_build(bw, lens, Ow, dw, lambda, &args, &err);
         CHECK(stt == LP_OK, "backward_build: %s", err.message);

@@ -30,83 +30,7 @@
 /* small helpers                                                       */
 /* ------------------------------------------------------------------ */
 
-#include "lens_reference.h"
-
-/* Snell: d hits a surface with (either-sided) normal n from index n1 into
- * n2; 0 under TIR. */
-
-#define MAXN 24
-typedef struct {
-    int n;                                   /* cap nodes 1..n */
-    lv3 p[MAXN + 2], nrm[MAXN + 2], din[MAXN + 2], drefl[MAXN + 2], dtran[MAXN + 2];
-    int surf[MAXN + 2], tir[MAXN + 2], good[MAXN + 2];
-    ref_real seg[MAXN + 2];                  /* internal length node k-1 -> k */
-    ref_real cosi[MAXN + 2];
-    int rim_depth;                           /* node index of the rim, 0 none */
-    lv3 rim_p;                               /* where the chain meets the rim */
-    ref_real rim_cos;                        /* |cos| of incidence on the rim */
-    int leak;
-} chain;
-
-static void build_chain(const ref_lens *L, ref_real ng, ref_real nm, lv3 O, lv3 d, chain *c)
-{
-    memset(c, 0, sizeof *c);
-    ref_hit h = ref_intersect(L, O, d, REF(0.0));
-    if (h.surf < 0)
-        return;
-    if (h.surf == LP_SURFACE_RIM) {
-        c->rim_depth = 1;
-        c->rim_p = h.p;
-        c->rim_cos = ref_fabs(ldot(d, h.n));
-        return;
-    }
-    lv3 dir = d;
-    ref_real n1 = nm, n2 = ng;
-    ref_real edge_m = REF(1e-6) * L->size;
-    for (int k = 1; k <= MAXN; k++) {
-        c->n = k;
-        c->p[k] = h.p;
-        c->nrm[k] = h.n;
-        c->surf[k] = h.surf;
-        c->din[k] = dir;
-        ref_real ci = ref_fabs(ldot(dir, h.n));
-        c->cosi[k] = ci;
-        c->drefl[k] = lreflect(dir, h.n);
-        c->tir[k] = !lrefract(dir, h.n, n1, n2, &c->dtran[k]);
-        /* conditioning: away from the cap's edge circle, not grazing, not
-         * near the critical angle */
-        ref_real a = h.surf == LP_SURFACE_BACK ? L->a2 : L->a1;
-        ref_real r = ref_sqrt(h.p.x * h.p.x + h.p.y * h.p.y);
-        ref_real x = (n1 / n2) * ref_sqrt((1 - ci) * (1 + ci)); /* sin of refraction */
-        int good = r < a - edge_m && ci > REF(0.02) && ref_fabs(x - 1) > REF(1e-3);
-        if (!c->tir[k])
-            good = good && ref_sqrt((1 - x) * (1 + x)) > REF(0.02);
-        c->good[k] = good;
-        lv3 next;
-        if (k == 1) {
-            if (c->tir[1])
-                return;
-            next = c->dtran[1];
-            n1 = ng;
-            n2 = nm;
-        } else {
-            next = c->drefl[k];
-        }
-        h = ref_intersect(L, h.p, next, REF(1e-9) * L->size);
-        if (h.surf < 0) {
-            c->leak = 1;
-            return;
-        }
-        if (h.surf == LP_SURFACE_RIM) {
-            c->rim_depth = k + 1;
-            c->rim_p = h.p;
-            c->rim_cos = ref_fabs(ldot(next, h.n));
-            return;
-        }
-        c->seg[k + 1] = h.s;
-        dir = next;
-    }
-}
+#include "lens_reference.h" /* the reference chain: ref_build_cap_chain */
 
 /* ------------------------------------------------------------------ */
 
@@ -376,7 +300,7 @@ static void test_rim_depth_random(void)
         return;
     lp_result res;
     lp_result_init(&res);
-    long hist[MAXN + 2] = {0};
+    long hist[REF_CHAIN_MAX + 2] = {0};
     long compared = 0, skipped = 0;
     for (int li = 0; li < 300; li++) {
         rng_state = SEED + (uint64_t)li * 0x9E3779B97F4A7C15ULL;
@@ -404,8 +328,8 @@ static void test_rim_depth_random(void)
             lp_trace_args_init(&args);
             args.max_depth = 1 + (int)(sm64() % 12);
             args.mode = (lp_mode)(sm64() % 3);
-            chain c;
-            build_chain(&L, ng, nm, O, d, &c);
+            ref_cap_chain c;
+            ref_build_cap_chain(&L, ng, nm, O, d, &c);
             /* expected rim depth, and whether the chain is unambiguous */
             int want = c.rim_depth;
             int good = !c.leak;

@@ -1,0 +1,385 @@
+/* sa_chart.c -- the chart and the page (see sa_chart.h). */
+#include "sa_chart.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support/image.h"
+#include "plot.h"
+
+#define PANEL_W 560
+#define PANEL_H 420
+#define COLUMNS 3
+#define MAX_SCENES 32
+#define MAX_SERIES 2048
+#define Y_FLOOR 1e-7 /* an error of 0 is drawn here */
+
+static const double TOLS[3] = {1e-2, 1e-3, 1e-4};
+static const unsigned TOL_COLOR[3] = {0x1f77b4u, 0x2ca02cu, 0x9467bdu};
+#define FRONT_COLOR 0xff7f0eu
+#define POV_COLOR 0xd62728u
+#define SWEEP_COLOR 0x9a9a9au
+
+static int is(const sa_point *p, const char *kind)
+{
+    return strcmp(p->kind, kind) == 0;
+}
+
+static double err_y(double e)
+{
+    return e > Y_FLOOR ? e : Y_FLOOR;
+}
+
+/* The scenes in order of first appearance. */
+static size_t scene_list(const sa_points *ps, const char **names)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < ps->n; i++) {
+        size_t k;
+        for (k = 0; k < n; k++)
+            if (strcmp(names[k], ps->p[i].scene) == 0)
+                break;
+        if (k == n && n < MAX_SCENES)
+            names[n++] = ps->p[i].scene;
+    }
+    return n;
+}
+
+static int timed(const sa_point *p)
+{
+    return isfinite(p->seconds) && p->seconds > 0.0 && isfinite(p->err.rmse);
+}
+
+/* Storage for the little line pieces a panel is drawn with. */
+typedef struct pieces {
+    double xy[MAX_SERIES][2][4];
+    pl_series s[MAX_SERIES];
+    size_t n;
+} pieces;
+
+static void add_line(pieces *pc, const double *x, const double *y, size_t n, unsigned color,
+                     pl_dash dash, double width, const char *label)
+{
+    if (pc->n >= MAX_SERIES || n > 4)
+        return;
+    for (size_t k = 0; k < n; k++) {
+        pc->xy[pc->n][0][k] = x[k];
+        pc->xy[pc->n][1][k] = y[k];
+    }
+    pc->s[pc->n] = (pl_series){label, pc->xy[pc->n][0], pc->xy[pc->n][1], n, color, dash, width};
+    pc->n++;
+}
+
+/* A marker at (x, y): shape 0 '+', 1 'x', 2 diamond.  sx in data x units,
+ * fy a factor of y. */
+static void add_marker(pieces *pc, double x, double y, double sx, double fy, int shape,
+                       unsigned color, double width)
+{
+    if (shape == 0) {
+        double hx[2] = {x - sx, x + sx}, hy[2] = {y, y};
+        double vx[2] = {x, x}, vy[2] = {y / fy, y * fy};
+        add_line(pc, hx, hy, 2, color, PL_SOLID, width, NULL);
+        add_line(pc, vx, vy, 2, color, PL_SOLID, width, NULL);
+    } else if (shape == 1) {
+        double ax[2] = {x - sx, x + sx}, ay[2] = {y / fy, y * fy};
+        double bx[2] = {x - sx, x + sx}, by[2] = {y * fy, y / fy};
+        add_line(pc, ax, ay, 2, color, PL_SOLID, width, NULL);
+        add_line(pc, bx, by, 2, color, PL_SOLID, width, NULL);
+    } else {
+        double dx[4] = {x - sx, x, x + sx, x}, dy[4] = {y, y * fy, y, y / fy};
+        double ex[2] = {x, x - sx}, ey[2] = {y / fy, y};
+        add_line(pc, dx, dy, 4, color, PL_SOLID, width, NULL);
+        add_line(pc, ex, ey, 2, color, PL_SOLID, width, NULL);
+    }
+}
+
+static int cmp_time(const void *a, const void *b)
+{
+    const sa_point *p = *(const sa_point *const *)a, *q = *(const sa_point *const *)b;
+    if (p->seconds != q->seconds)
+        return (p->seconds > q->seconds) - (p->seconds < q->seconds);
+    return (p->err.rmse > q->err.rmse) - (p->err.rmse < q->err.rmse);
+}
+
+/* The swept points of a scene sorted by time; returns the count. */
+static size_t swept(const sa_points *ps, const char *scene, const sa_point **out, size_t max)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < ps->n && n < max; i++)
+        if (strcmp(ps->p[i].scene, scene) == 0 && (is(&ps->p[i], "sweep")) && timed(&ps->p[i]))
+            out[n++] = &ps->p[i];
+    qsort(out, n, sizeof *out, cmp_time);
+    return n;
+}
+
+static int draw_panel(rs_image *img, int x0, int y0, const sa_points *ps, const char *scene,
+                      pieces *pc, char *msg, size_t msg_size)
+{
+    const sa_point *sw[1024];
+    size_t n = swept(ps, scene, sw, 1024);
+    double tmin = INFINITY, tmax = 0.0, emin = INFINITY, emax = 0.0;
+    pl_chart ch;
+
+    pc->n = 0;
+    for (size_t i = 0; i < ps->n; i++) {
+        const sa_point *p = &ps->p[i];
+        if (strcmp(p->scene, scene) != 0 || !timed(p))
+            continue;
+        tmin = fmin(tmin, p->seconds);
+        tmax = fmax(tmax, p->seconds);
+        emin = fmin(emin, err_y(p->err.rmse));
+        emax = fmax(emax, err_y(p->err.rmse));
+    }
+    if (!(tmax > 0.0))
+        return 0;
+    memset(&ch, 0, sizeof ch);
+    ch.title = scene;
+    ch.xlabel = "CPU seconds, one thread (log10)";
+    ch.ylabel = "RMSE vs reference";
+    ch.xmin = floor(log10(tmin) * 2.0) / 2.0 - 0.1;
+    ch.xmax = ceil(log10(tmax) * 2.0) / 2.0 + 0.1;
+    ch.ylog = 1;
+    ch.ymin = pow(10.0, floor(log10(fmin(emin, 1e-4))));
+    ch.ymax = pow(10.0, ceil(log10(fmax(emax, 1e-2)) + 0.01));
+    ch.legend = PL_LEGEND_NONE;
+    ch.xstep = 0.5;
+    ch.text_scale = 2;
+    double sx = 0.012 * (ch.xmax - ch.xmin);
+    double fy = pow(ch.ymax / ch.ymin, 0.016);
+
+    for (int t = 0; t < 3; t++) {
+        double x[2] = {ch.xmin, ch.xmax}, y[2] = {TOLS[t], TOLS[t]};
+        add_line(pc, x, y, 2, TOL_COLOR[t], PL_DOTTED, 1.5, NULL);
+    }
+    for (size_t k = 0; k < n; k++)
+        add_marker(pc, log10(sw[k]->seconds), err_y(sw[k]->err.rmse), sx, fy, 0, SWEEP_COLOR, 1.2);
+    /* The Pareto front: each point faster than all that are more accurate. */
+    {
+        double best = INFINITY, px = NAN, py = NAN;
+        for (size_t k = 0; k < n; k++) {
+            double e = err_y(sw[k]->err.rmse);
+            if (!(e < best))
+                continue;
+            double x = log10(sw[k]->seconds);
+            if (isfinite(px)) {
+                double lx[3] = {px, x, x}, ly[3] = {py, py, e};
+                add_line(pc, lx, ly, 3, FRONT_COLOR, PL_SOLID, 2.0, NULL);
+            }
+            best = e;
+            px = x;
+            py = e;
+        }
+    }
+    for (size_t i = 0; i < ps->n; i++) {
+        const sa_point *p = &ps->p[i];
+        if (strcmp(p->scene, scene) != 0 || !timed(p))
+            continue;
+        if (is(p, "povray"))
+            add_marker(pc, log10(p->seconds), err_y(p->err.rmse), 1.6 * sx, pow(fy, 1.6), 1,
+                       POV_COLOR, 2.5);
+        if (is(p, "auto"))
+            for (int t = 0; t < 3; t++)
+                if (fabs(p->tolerance / TOLS[t] - 1.0) < 1e-6)
+                    add_marker(pc, log10(p->seconds), err_y(p->err.rmse), 1.6 * sx, pow(fy, 1.6), 2,
+                               TOL_COLOR[t], 2.5);
+    }
+    return pl_draw(img, x0, y0, PANEL_W, PANEL_H, &ch, pc->s, pc->n, msg, msg_size);
+}
+
+static int write_png(const sa_points *ps, const char **names, size_t ns, const char *dir,
+                     char *msg, size_t msg_size)
+{
+    rs_image img;
+    char path[4096];
+    int rows = (int)((ns + COLUMNS - 1) / COLUMNS);
+    int key_h = 70;
+    pieces *pc = malloc(sizeof *pc);
+    int rc = 0;
+    if (!pc || rs_image_create(&img, COLUMNS * PANEL_W, rows * PANEL_H + key_h) != 0) {
+        free(pc);
+        snprintf(msg, msg_size, "out of memory for the chart");
+        return -1;
+    }
+    pl_fill(&img, 0xffffffu);
+    for (size_t k = 0; k < ns && rc == 0; k++)
+        rc = draw_panel(&img, (int)(k % COLUMNS) * PANEL_W, (int)(k / COLUMNS) * PANEL_H, ps,
+                        names[k], pc, msg, msg_size);
+    if (rc == 0) {
+        int y = rows * PANEL_H + 10, x = 20;
+        pl_text(&img, x, y, 2, SWEEP_COLOR, "+ swept setting");
+        pl_text(&img, x + 260, y, 2, FRONT_COLOR, "-- Pareto front");
+        pl_text(&img, x + 520, y, 2, POV_COLOR, "x POV-Ray (no dispersion)");
+        pl_text(&img, x, y + 30, 2, TOL_COLOR[0], "<> auto, E = 1e-2");
+        pl_text(&img, x + 260, y + 30, 2, TOL_COLOR[1], "<> auto, E = 1e-3");
+        pl_text(&img, x + 520, y + 30, 2, TOL_COLOR[2], "<> auto, E = 1e-4");
+        pl_text(&img, x + 820, y + 30, 2, 0x606060u, "dotted: the three E");
+        snprintf(path, sizeof path, "%s/speed-accuracy.png", dir);
+        rc = rs_png_write(path, &img, msg, msg_size);
+    }
+    rs_image_free(&img);
+    free(pc);
+    return rc;
+}
+
+static const sa_point *find(const sa_points *ps, const char *scene, const char *kind, double tol)
+{
+    for (size_t i = 0; i < ps->n; i++)
+        if (strcmp(ps->p[i].scene, scene) == 0 && is(&ps->p[i], kind) &&
+            (tol <= 0.0 || fabs(ps->p[i].tolerance / tol - 1.0) < 1e-6))
+            return &ps->p[i];
+    return NULL;
+}
+
+static void setting(char *out, size_t size, const sa_point *p)
+{
+    char cut[32];
+    if (p->cutoff < 0.0)
+        snprintf(cut, sizeof cut, "scene's");
+    else
+        snprintf(cut, sizeof cut, "%g", p->cutoff);
+    if (strcmp(p->model, "rgb") == 0)
+        snprintf(out, size, "rgb, depth %d, cut-off %s", p->depth, cut);
+    else
+        snprintf(out, size, "%s, %d wl, depth %d, cut-off %s", p->model, p->wavelengths,
+                 p->depth, cut);
+}
+
+static const char *const PAGE_TEXT =
+"# Speed against accuracy\n"
+"\n"
+"![speed against accuracy](speed-accuracy.png)\n"
+"\n"
+"Every panel is one scene of `scenes/`.  Each grey cross is one render\n"
+"setting — light model × wavelength count × depth × branch cut-off — at\n"
+"its cost (x: CPU seconds of the `lensrender` process on one thread,\n"
+"logarithmic) and its error (y: RMSE of linear RGB against the scene's\n"
+"converged reference, logarithmic).  The orange line is the Pareto front:\n"
+"the settings that no other swept setting beats in both time and error.\n"
+"The red × is POV-Ray 3.7 rendering the same scene (translated by\n"
+"`pov_compare`: glass a constant index n_d, no dispersion, no polarizers,\n"
+"one thread), against the same reference — its error is what leaving out\n"
+"dispersion and polarization costs.  The diamonds are `--mode auto\n"
+"--tolerance E` for E = 1e-2 (blue), 1e-3 (green), 1e-4 (purple), and\n"
+"the dotted lines the three E: a diamond should lie below its own line\n"
+"and near the front's left end below that line.\n"
+"\n"
+"**Reading it.** Move left along the front to see how much accuracy a\n"
+"faster setting gives up; a setting far right of the front at the same\n"
+"height wastes time.  Wavelengths are the main cost and, through\n"
+"dispersion, the main error: at a coloured edge seen through glass the\n"
+"integrand over wavelength has a step, so the midpoint rule's error\n"
+"falls only as 1/N.  Depth and cut-off matter less once the tree is\n"
+"deep enough; the light model matters where polarization does (the\n"
+"polarizer scenes, strong ghosts in dense glass).\n"
+"\n"
+"**How it is measured.** `sh scripts/speed_accuracy.sh` builds the\n"
+"project and runs `build/bin/speed_accuracy`, which for every scene\n"
+"\n"
+"1. renders the reference: polarized, no cut-off, wavelengths from 64\n"
+"   and depth from 16, each doubled while the doubling changes some\n"
+"   pixel by more than 1e-5 (caps: 1024 wavelengths, the renderer's\n"
+"   limit, and depth 64); the\n"
+"   table below gives the last doubling's change, which is the\n"
+"   reference's own uncertainty;\n"
+"2. renders every swept setting, auto at the three E, the renderer's\n"
+"   default (polarized, 16 wavelengths, the scene's depth and\n"
+"   `adc_bailout`) and POV-Ray, each `--runs` times (default 3; a setting\n"
+"   slower than 5 s once) and takes the median CPU time (user + system of\n"
+"   the child process, from `wait4`): the machine these figures come\n"
+"   from is shared, and CPU time does not count the time other work held\n"
+"   the cores, wall time would (with 8 engineers' work on 2 cores a\n"
+"   render's wall time was 5-25 times its CPU time);\n"
+"3. writes `speed-accuracy.csv` (every point: scene, kind, model,\n"
+"   wavelengths, depth, cut-off, tolerance, seconds, runs, rmse, largest\n"
+"   channel error, share of pixels off by more than 1/255 after the sRGB\n"
+"   curve, note), this chart and this page.\n"
+"\n"
+"The images are small (32 × 24 by default) so the sweep finishes in\n"
+"reasonable time; errors are per pixel and depend little on size, times\n"
+"scale with the pixel count -- except auto's probe, which has a floor of\n"
+"64 pixels and so weighs most at this size.  A scene missing from the\n"
+"chart was not swept (see the CSV).\n"
+"\n";
+
+static int write_md(const sa_points *ps, const char **names, size_t ns, const char *dir,
+                    char *msg, size_t msg_size)
+{
+    char path[4096], tmp[4200];
+    FILE *f;
+    snprintf(path, sizeof path, "%s/speed-accuracy.md", dir);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    f = fopen(tmp, "w");
+    if (!f) {
+        snprintf(msg, msg_size, "%s: cannot write", tmp);
+        return -1;
+    }
+    fputs(PAGE_TEXT, f);
+    fputs("## Auto against the front\n\n"
+          "Per scene and E: auto's choice, its error and time; the cheapest swept\n"
+          "setting whose error is ≤ E; auto's time over that one's (the goal is\n"
+          "≤ 1.25) and over the default polarized render's.\n\n"
+          "| scene | E | auto's choice | auto rmse | auto s | cheapest swept ≤ E | its rmse | its s "
+          "| auto / cheapest | auto / default |\n"
+          "|---|---|---|---|---|---|---|---|---|---|\n", f);
+    for (size_t k = 0; k < ns; k++) {
+        const sa_point *dflt = find(ps, names[k], "default", 0.0);
+        const sa_point *sw[1024];
+        size_t n = swept(ps, names[k], sw, 1024);
+        for (int t = 0; t < 3; t++) {
+            const sa_point *a = find(ps, names[k], "auto", TOLS[t]), *best = NULL;
+            char s1[128] = "—";
+            for (size_t i = 0; i < n && !best; i++)
+                if (sw[i]->err.rmse <= TOLS[t])
+                    best = sw[i];
+            if (best)
+                setting(s1, sizeof s1, best);
+            fprintf(f, "| %s | %g | %s | %.2g | %.3g | %s | %.2g | %.3g | %.2f | %.2f |\n",
+                    names[k], TOLS[t], a ? a->note : "—", a ? a->err.rmse : NAN,
+                    a ? a->seconds : NAN, s1, best ? best->err.rmse : NAN,
+                    best ? best->seconds : NAN, a && best ? a->seconds / best->seconds : NAN,
+                    a && dflt ? a->seconds / dflt->seconds : NAN);
+        }
+    }
+    fputs("\n## The references and POV-Ray\n\n"
+          "| scene | reference | its last doubling | default polarized: rmse, s | POV-Ray: rmse, "
+          "largest, share > 1/255, s |\n|---|---|---|---|---|\n", f);
+    for (size_t k = 0; k < ns; k++) {
+        const sa_point *r = find(ps, names[k], "reference", 0.0);
+        const sa_point *d = find(ps, names[k], "default", 0.0);
+        const sa_point *p = find(ps, names[k], "povray", 0.0);
+        fprintf(f, "| %s | ", names[k]);
+        if (r)
+            fprintf(f, "%d wl, depth %d | %s | ", r->wavelengths, r->depth, r->note);
+        else
+            fputs("— | — | ", f);
+        if (d)
+            fprintf(f, "%.2g, %.3g | ", d->err.rmse, d->seconds);
+        else
+            fputs("— | ", f);
+        if (p)
+            fprintf(f, "%.2g, %.2g, %.1f %%, %.3g |\n", p->err.rmse, p->err.max_abs,
+                    100.0 * p->err.share_visible, p->seconds);
+        else
+            fputs("— |\n", f);
+    }
+    if (fclose(f) != 0 || rename(tmp, path) != 0) {
+        snprintf(msg, msg_size, "%s: cannot write", path);
+        return -1;
+    }
+    return 0;
+}
+
+int sa_chart_write(const sa_points *ps, const char *dir, char *msg, size_t msg_size)
+{
+    const char *names[MAX_SCENES];
+    size_t ns = scene_list(ps, names);
+    if (ns == 0) {
+        snprintf(msg, msg_size, "no points");
+        return -1;
+    }
+    if (write_png(ps, names, ns, dir, msg, msg_size) != 0)
+        return -1;
+    return write_md(ps, names, ns, dir, msg, msg_size);
+}

@@ -1,0 +1,596 @@
+/* speed_accuracy.c -- what each render setting costs and how wrong it is.
+ *
+ * For every scene: a converged reference (polarized, wavelengths and
+ * depth doubled until a doubling changes no pixel by more than 1e-5, or
+ * their caps; no cut-off), then a sweep of light model x wavelength count
+ * x depth x cut-off, --mode auto at three tolerances and POV-Ray itself,
+ * each render timed on one thread (CPU time, median of several runs) and
+ * compared with the reference.  Writes the table (CSV), the chart (PNG)
+ * and the page that explains them (Markdown).  The definitions are in the
+ * usage text and in the page it writes. */
+#define _POSIX_C_SOURCE 200809L
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <dirent.h>
+#include <unistd.h>
+
+#include "support/image.h"
+#include "sa_chart.h"
+#include "sa_error.h"
+#include "sa_point.h"
+#include "sa_run.h"
+
+#define EXIT_USAGE 2
+#define PATH_MAX_LEN 4096
+#define PATH_BUF (PATH_MAX_LEN + 64) /* a directory and a file name in it */
+
+static const char *const usage_text[] = {
+"usage: speed_accuracy [--bin DIR] [--scenes DIR] [--docs DIR] [--work DIR]\n"
+"                      [--width W] [--height H] [--runs K] [--scene NAME]...\n"
+"                      [--max-wavelengths N] [--reuse-references]\n"
+"       speed_accuracy --chart-only [--docs DIR]\n"
+"       speed_accuracy --help\n"
+"\n"
+"Sweeps every scene of DIR (default scenes) and writes into the docs\n"
+"directory (default docs): speed-accuracy.csv, speed-accuracy.png and\n"
+"speed-accuracy.md.  --chart-only redraws the chart and the page from an\n"
+"existing CSV.\n"
+"\n",
+"  --bin DIR        where lensrender and pov_compare are (default build/bin)\n"
+"  --work DIR       references and renders (default build/speed-accuracy)\n"
+"  --width W, --height H   image size of every render (default 32 x 24)\n"
+"  --runs K         timed runs per setting; its time is their median\n"
+"                   (default 3; a setting slower than 5 s runs once)\n"
+"  --scene NAME     only this scene (repeatable; default every *.scene)\n"
+"  --max-wavelengths N   the reference's wavelength cap, <= 1024 (default 1024)\n"
+"  --reuse-references    keep references already in the work directory\n"
+"  --references-only     make the references and stop\n"
+"\n"
+"REFERENCE: polarized, no cut-off, wavelengths from 64 and depth from 16,\n"
+"each doubled while doubling it changes some pixel by more than 1e-5 (up\n"
+"to the cap, and depth 64).  ERROR: RMSE of linear RGB against it, the\n"
+"largest channel difference, and the share of pixels with a channel off\n"
+"by more than 1/255 after the sRGB curve.  TIME: CPU seconds of the\n"
+"lensrender (or povray) process, --threads 1.\n",
+};
+
+typedef struct opts {
+    const char *bin, *scenes, *docs, *work;
+    int width, height, runs, max_wavelengths, reuse, chart_only, references_only;
+    const char *only[64];
+    int n_only;
+} opts;
+
+static void say(const char *fmt, const char *a, const char *b)
+{
+    fprintf(stderr, "speed_accuracy: ");
+    fprintf(stderr, fmt, a, b);
+    fputc('\n', stderr);
+}
+
+/* Make a directory whose parent exists (the script makes the docs and
+ * work directories). */
+static int make_dir(const char *path)
+{
+    return mkdir(path, 0777) == 0 || errno == EEXIST ? 0 : -1;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* ---- one render ---------------------------------------------------------- */
+
+typedef struct scene_ctx {
+    const opts *o;
+    const char *path;    /* the scene file */
+    char name[256];      /* its base name without .scene */
+    char dir[PATH_MAX_LEN]; /* its work directory */
+    rs_image ref;
+    int ref_wavelengths, ref_depth;
+    double ref_dn_max, ref_dd_max, ref_dn_rmse; /* last doubling changes */
+} scene_ctx;
+
+/* Render the setting p once or several times; fills p->seconds and, when
+ * img is not NULL, reads the image into *img.  Returns 0, or -1 with a
+ * message on stderr. */
+static int render(const scene_ctx *sc, sa_point *p, int runs, rs_image *img)
+{
+    char pfm[PATH_BUF], png[PATH_BUF], exe[PATH_BUF];
+    char w[16], h[16], nl[16], dp[16], cut[32], tol[32], msg[512];
+    char *argv[32];
+    int n = 0;
+    double times[16];
+
+    snprintf(exe, sizeof exe, "%s/lensrender", sc->o->bin);
+    snprintf(pfm, sizeof pfm, "%s/render.pfm", sc->dir);
+    snprintf(png, sizeof png, "%s/render.png", sc->dir);
+    snprintf(w, sizeof w, "%d", sc->o->width);
+    snprintf(h, sizeof h, "%d", sc->o->height);
+    argv[n++] = exe;
+    argv[n++] = (char *)sc->path;
+    argv[n++] = "--threads";
+    argv[n++] = "1";
+    argv[n++] = "--width";
+    argv[n++] = w;
+    argv[n++] = "--height";
+    argv[n++] = h;
+    argv[n++] = "-o";
+    argv[n++] = png;
+    argv[n++] = "--pfm";
+    argv[n++] = pfm;
+    argv[n++] = "--mode";
+    argv[n++] = p->model;
+    if (p->tolerance > 0.0) {
+        snprintf(tol, sizeof tol, "%.17g", p->tolerance);
+        argv[n++] = "--tolerance";
+        argv[n++] = tol;
+    } else {
+        argv[n++] = "--quiet";
+    }
+    if (p->wavelengths > 0) {
+        snprintf(nl, sizeof nl, "%d", p->wavelengths);
+        argv[n++] = "--wavelengths";
+        argv[n++] = nl;
+    }
+    if (p->depth > 0) {
+        snprintf(dp, sizeof dp, "%d", p->depth);
+        argv[n++] = "--depth";
+        argv[n++] = dp;
+    }
+    if (p->cutoff >= 0.0) {
+        snprintf(cut, sizeof cut, "%.17g", p->cutoff);
+        argv[n++] = "--cutoff";
+        argv[n++] = cut;
+    }
+    argv[n] = NULL;
+
+    if (runs > 16)
+        runs = 16;
+    for (int r = 0; r < runs; r++) {
+        sa_run_result res;
+        if (sa_run(argv, NULL, &res, msg, sizeof msg) != 0) {
+            say("%s: %s", exe, msg);
+            return -1;
+        }
+        if (res.status != 0) {
+            say("%s failed: %s", sc->path, res.err);
+            return -1;
+        }
+        times[r] = res.cpu_seconds;
+        if (r == 0 && p->tolerance > 0.0) {
+            /* "lensrender: auto: <choice>" is the first line. */
+            const char *c = strstr(res.err, "auto: ");
+            if (c) {
+                size_t k = 0;
+                c += strlen("auto: ");
+                while (c[k] && c[k] != '\n' && k + 1 < sizeof p->note)
+                    k++;
+                memcpy(p->note, c, k);
+                p->note[k] = '\0';
+            }
+        }
+        if (r == 0 && runs > 1 && res.cpu_seconds > 5.0) {
+            runs = 1;
+            break;
+        }
+    }
+    qsort(times, (size_t)runs, sizeof *times, cmp_double);
+    p->seconds = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
+    p->runs = runs;
+    if (img && rs_pfm_read(pfm, img, msg, sizeof msg) != 0) {
+        say("%s: %s", pfm, msg);
+        return -1;
+    }
+    return 0;
+}
+
+static double max_abs_diff(const rs_image *a, const rs_image *b)
+{
+    sa_error e;
+    if (sa_error_measure(a, b, &e) != 0)
+        return INFINITY;
+    return e.max_abs;
+}
+
+/* ---- the converged reference -------------------------------------------- */
+
+#define REF_TOL 1e-5
+#define REF_DEPTH0 16
+#define REF_DEPTH_MAX 64
+#define REF_WAVELENGTHS0 64
+
+static int save_reference(scene_ctx *sc)
+{
+    char path[PATH_BUF], msg[512];
+    FILE *f;
+    snprintf(path, sizeof path, "%s/reference.pfm", sc->dir);
+    if (rs_pfm_write(path, &sc->ref, msg, sizeof msg) != 0) {
+        say("%s: %s", path, msg);
+        return -1;
+    }
+    snprintf(path, sizeof path, "%s/reference.txt", sc->dir);
+    f = fopen(path, "w");
+    if (!f)
+        return -1;
+    fprintf(f, "%d %d %d %d %.9g %.9g %.9g\n", sc->o->width, sc->o->height, sc->ref_wavelengths,
+            sc->ref_depth, sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max);
+    return fclose(f) == 0 ? 0 : -1;
+}
+
+static int load_reference(scene_ctx *sc)
+{
+    char path[PATH_BUF], msg[512];
+    int w, h;
+    FILE *f;
+    snprintf(path, sizeof path, "%s/reference.txt", sc->dir);
+    f = fopen(path, "r");
+    if (!f)
+        return -1;
+    int ok = fscanf(f, "%d %d %d %d %lg %lg %lg", &w, &h, &sc->ref_wavelengths, &sc->ref_depth,
+                    &sc->ref_dn_max, &sc->ref_dn_rmse, &sc->ref_dd_max) == 7;
+    fclose(f);
+    if (!ok || w != sc->o->width || h != sc->o->height)
+        return -1;
+    snprintf(path, sizeof path, "%s/reference.pfm", sc->dir);
+    return rs_pfm_read(path, &sc->ref, msg, sizeof msg);
+}
+
+static int make_reference(scene_ctx *sc)
+{
+    sa_point p;
+    rs_image base, more_n, more_d;
+    int n = REF_WAVELENGTHS0, d = REF_DEPTH0;
+    int n_done = 0, d_done = 0;
+
+    if (sc->o->reuse && load_reference(sc) == 0) {
+        fprintf(stderr, "speed_accuracy: %s: reference reused (%d wavelengths, depth %d)\n",
+                sc->name, sc->ref_wavelengths, sc->ref_depth);
+        return 0;
+    }
+    memset(&base, 0, sizeof base);
+    sa_point_init(&p, "reference", "polarized", n, d, 0.0);
+    if (render(sc, &p, 1, &base) != 0)
+        return -1;
+    while (!(n_done && d_done)) {
+        if (!n_done) {
+            memset(&more_n, 0, sizeof more_n);
+            sa_point_init(&p, "reference", "polarized", 2 * n, d, 0.0);
+            if (render(sc, &p, 1, &more_n) != 0)
+                return -1;
+            sc->ref_dn_max = max_abs_diff(&more_n, &base);
+            sc->ref_dn_rmse = rs_image_rmse(&more_n, &base);
+            fprintf(stderr, "speed_accuracy: %s: wavelengths %d -> %d: max change %.3g, rmse %.3g\n",
+                    sc->name, n, 2 * n, sc->ref_dn_max, sc->ref_dn_rmse);
+            rs_image_free(&base);
+            base = more_n;
+            n *= 2;
+            n_done = sc->ref_dn_max <= REF_TOL || 2 * n > sc->o->max_wavelengths;
+        }
+        if (!d_done) {
+            memset(&more_d, 0, sizeof more_d);
+            sa_point_init(&p, "reference", "polarized", n, 2 * d, 0.0);
+            if (render(sc, &p, 1, &more_d) != 0)
+                return -1;
+            sc->ref_dd_max = max_abs_diff(&more_d, &base);
+            fprintf(stderr, "speed_accuracy: %s: depth %d -> %d: max change %.3g\n", sc->name, d,
+                    2 * d, sc->ref_dd_max);
+            rs_image_free(&base);
+            base = more_d;
+            d *= 2;
+            d_done = sc->ref_dd_max <= REF_TOL || 2 * d > REF_DEPTH_MAX;
+        }
+    }
+    sc->ref = base;
+    sc->ref_wavelengths = n;
+    sc->ref_depth = d;
+    return save_reference(sc);
+}
+
+/* ---- POV-Ray's own point ------------------------------------------------ */
+
+/* pov_compare writes the POV-Ray scene (glass a constant index n_d, no
+ * dispersion, adc_bailout 0, the scene's depth); then povray renders it
+ * on one thread, timed like every other point. */
+static int povray_point(const scene_ctx *sc, sa_point *p)
+{
+    char exe[PATH_BUF], out[PATH_BUF], w[16], h[16], msg[512];
+    char a_w[24], a_h[24];
+    sa_run_result res;
+    rs_image img;
+    int bits;
+    double times[16];
+    int runs = sc->o->runs > 16 ? 16 : sc->o->runs;
+
+    sa_point_init(p, "povray", "povray", 0, 0, 0.0);
+    snprintf(exe, sizeof exe, "%s/pov_compare", sc->o->bin);
+    snprintf(out, sizeof out, "%s/pov", sc->dir);
+    snprintf(w, sizeof w, "%d", sc->o->width);
+    snprintf(h, sizeof h, "%d", sc->o->height);
+    {
+        char *argv[] = {exe, (char *)sc->path, "--out", out, "--width", w, "--height", h,
+                        "--threads", "1", "--quiet", NULL};
+        if (sa_run(argv, NULL, &res, msg, sizeof msg) != 0 || res.status != 0) {
+            say("%s: pov_compare failed: %s", sc->name, res.err);
+            return -1;
+        }
+    }
+    snprintf(a_w, sizeof a_w, "+W%d", sc->o->width);
+    snprintf(a_h, sizeof a_h, "+H%d", sc->o->height);
+    char *argv[] = {"povray", "-D", "-V", "-GS", "-GR", "+Iscene.pov", "+Opoint.png", a_w, a_h,
+                    "-A", "+Q9", "-UA", "+FN16", "File_Gamma=1.0", "Dither=off", "+WT1", NULL};
+    for (int r = 0; r < runs; r++) {
+        if (sa_run(argv, out, &res, msg, sizeof msg) != 0 || res.status != 0) {
+            say("%s: povray failed: %s", sc->name, res.err);
+            return -1;
+        }
+        times[r] = res.cpu_seconds;
+    }
+    qsort(times, (size_t)runs, sizeof *times, cmp_double);
+    p->seconds = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
+    p->runs = runs;
+    snprintf(out, sizeof out, "%s/pov/point.png", sc->dir);
+    if (rs_png_read(out, &img, &bits, msg, sizeof msg) != 0) {
+        say("%s: %s", out, msg);
+        return -1;
+    }
+    sa_error_measure(&img, &sc->ref, &p->err);
+    rs_image_free(&img);
+    snprintf(p->note, sizeof p->note, "POV-Ray 3.7, glass at n_d, no dispersion");
+    return 0;
+}
+
+/* ---- the sweep ------------------------------------------------------------ */
+
+static const char *const MODELS[] = {"polarized", "fresnel", "schlick", "rgb"};
+static const int WAVELENGTHS[] = {4, 8, 16, 32, 64, 128, 256, 512};
+static const int DEPTHS[] = {4, 8, 16};
+static const double CUTOFFS[] = {0.0, 1e-3, -1.0}; /* -1: the scene's adc_bailout */
+static const double TOLERANCES[] = {1e-2, 1e-3, 1e-4};
+
+#define N_OF(a) (sizeof(a) / sizeof *(a))
+
+/* Is the setting in the sweep?  Every model, depth and cut-off up to 64
+ * wavelengths; beyond, the two models that can converge (polarized; and
+ * fresnel, for scenes where it is exact enough) at depth 16 without
+ * cut-off and at depth 8 with cut-off 1e-3; schlick at depth 16 without
+ * cut-off; rgb has no wavelength count. */
+static int in_sweep(int m, int wl, int d, int c)
+{
+    int full = WAVELENGTHS[wl] <= 32;
+    if (m == 3)
+        return wl == 0;
+    if (m == 2)
+        return DEPTHS[d] == 16 && c == 0;
+    return full || (DEPTHS[d] == 16 && c == 0) || (DEPTHS[d] == 8 && CUTOFFS[c] == 1e-3);
+}
+
+/* Render p, measure it against the reference and record it. */
+static int measure(const scene_ctx *sc, sa_point *p, sa_points *all, FILE *csv)
+{
+    rs_image img;
+    memset(&img, 0, sizeof img);
+    if (render(sc, p, sc->o->runs, &img) != 0)
+        return -1;
+    sa_error_measure(&img, &sc->ref, &p->err);
+    rs_image_free(&img);
+    snprintf(p->scene, sizeof p->scene, "%.63s", sc->name);
+    return sa_points_add(all, p) != 0 || sa_point_write_csv(csv, p) != 0 ? -1 : 0;
+}
+
+static int run_scene(scene_ctx *sc, sa_points *all, FILE *csv)
+{
+    sa_point p;
+
+    if (make_reference(sc) != 0)
+        return -1;
+    if (sc->o->references_only)
+        return 0;
+    sa_point_init(&p, "reference", "polarized", sc->ref_wavelengths, sc->ref_depth, 0.0);
+    snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
+    snprintf(p.note, sizeof p.note, "doubling wavelengths: max %.3g rmse %.3g; depth: max %.3g",
+             sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max);
+    p.seconds = NAN;
+    if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
+        return -1;
+
+    if (povray_point(sc, &p) == 0) {
+        snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
+        if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
+            return -1;
+    }
+    for (size_t t = 0; t < N_OF(TOLERANCES); t++) {
+        sa_point_init(&p, "auto", "auto", 0, 0, -1.0);
+        p.tolerance = TOLERANCES[t];
+        if (measure(sc, &p, all, csv) != 0)
+            return -1;
+        fprintf(stderr, "speed_accuracy: %s: auto %g: %.3g s, rmse %.3g (%s)\n", sc->name,
+                p.tolerance, p.seconds, p.err.rmse, p.note);
+    }
+    for (size_t m = 0; m < N_OF(MODELS); m++)
+        for (size_t wl = 0; wl < N_OF(WAVELENGTHS); wl++)
+            for (size_t d = 0; d < N_OF(DEPTHS); d++)
+                for (size_t c = 0; c < N_OF(CUTOFFS); c++) {
+                    if (!in_sweep((int)m, (int)wl, (int)d, (int)c))
+                        continue;
+                    sa_point_init(&p, "sweep", MODELS[m], m == 3 ? 0 : WAVELENGTHS[wl],
+                                  DEPTHS[d], CUTOFFS[c]);
+                    if (measure(sc, &p, all, csv) != 0)
+                        return -1;
+                }
+    /* The default polarized render, for the ratio the page reports. */
+    sa_point_init(&p, "default", "polarized", 0, 0, -1.0);
+    return measure(sc, &p, all, csv);
+}
+
+/* ---- options ---------------------------------------------------------- */
+
+static int int_arg(const char *s, int lo, int hi, int *out)
+{
+    char *end;
+    long v = strtol(s, &end, 10);
+    if (end == s || *end || v < lo || v > hi)
+        return -1;
+    *out = (int)v;
+    return 0;
+}
+
+static int parse(opts *o, int argc, char **argv)
+{
+    o->bin = "build/bin";
+    o->scenes = "scenes";
+    o->docs = "docs";
+    o->work = "build/speed-accuracy";
+    o->width = 32;
+    o->height = 24;
+    o->runs = 3;
+    o->max_wavelengths = 1024;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            for (size_t k = 0; k < N_OF(usage_text); k++)
+                fputs(usage_text[k], stdout);
+            exit(0);
+        } else if (strcmp(a, "--reuse-references") == 0) {
+            o->reuse = 1;
+        } else if (strcmp(a, "--references-only") == 0) {
+            o->references_only = 1;
+        } else if (strcmp(a, "--chart-only") == 0) {
+            o->chart_only = 1;
+        } else if (!v) {
+            say("%s%s: unknown option or missing value (see --help)", a, "");
+            return -1;
+        } else if (strcmp(a, "--bin") == 0) {
+            o->bin = v, i++;
+        } else if (strcmp(a, "--scenes") == 0) {
+            o->scenes = v, i++;
+        } else if (strcmp(a, "--docs") == 0) {
+            o->docs = v, i++;
+        } else if (strcmp(a, "--work") == 0) {
+            o->work = v, i++;
+        } else if (strcmp(a, "--scene") == 0) {
+            if (o->n_only == (int)N_OF(o->only)) {
+                say("too many --scene%s%s", "", "");
+                return -1;
+            }
+            o->only[o->n_only++] = v, i++;
+        } else if (strcmp(a, "--width") == 0 || strcmp(a, "--height") == 0 ||
+                   strcmp(a, "--runs") == 0 || strcmp(a, "--max-wavelengths") == 0) {
+            int *dst = a[2] == 'w' ? &o->width : a[2] == 'h' ? &o->height
+                       : a[2] == 'r' ? &o->runs : &o->max_wavelengths;
+            if (int_arg(v, 1, a[2] == 'r' ? 15 : a[2] == 'm' ? 1024 : 16384, dst) != 0) {
+                say("%s: '%s' is out of range", a, v);
+                return -1;
+            }
+            i++;
+        } else {
+            say("unknown option '%s'%s (see --help)", a, "");
+            return -1;
+        }
+    }
+    return 0;
+}
+
+static int wanted(const opts *o, const char *name)
+{
+    if (o->n_only == 0)
+        return 1;
+    for (int k = 0; k < o->n_only; k++)
+        if (strcmp(o->only[k], name) == 0)
+            return 1;
+    return 0;
+}
+
+static int cmp_str(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+int main(int argc, char **argv)
+{
+    opts o;
+    sa_points all;
+    char csv_path[PATH_BUF], msg[512];
+    memset(&o, 0, sizeof o);
+    if (parse(&o, argc, argv) != 0)
+        return EXIT_USAGE;
+    sa_points_init(&all);
+    snprintf(csv_path, sizeof csv_path, "%.4000s/speed-accuracy.csv", o.docs);
+    if (make_dir(o.docs) != 0) {
+        say("%s: cannot create: %s", o.docs, strerror(errno));
+        return 1;
+    }
+
+    if (o.chart_only) {
+        if (sa_points_read_csv(csv_path, &all, msg, sizeof msg) != 0) {
+            say("%s: %s", csv_path, msg);
+            return 1;
+        }
+    } else {
+        char *names[256];
+        int n_names = 0;
+        FILE *csv;
+        char tmp[PATH_BUF + 8];
+        DIR *dir = opendir(o.scenes);
+        struct dirent *de;
+        if (!dir) {
+            say("%s: cannot list: %s", o.scenes, strerror(errno));
+            return 1;
+        }
+        while ((de = readdir(dir)) != NULL && n_names < 256) {
+            size_t n = strlen(de->d_name);
+            if (n > 6 && strcmp(de->d_name + n - 6, ".scene") == 0)
+                names[n_names++] = strdup(de->d_name);
+        }
+        closedir(dir);
+        qsort(names, (size_t)n_names, sizeof *names, cmp_str);
+        snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
+        csv = fopen(tmp, "w");
+        if (!csv || sa_point_write_csv_header(csv) != 0) {
+            say("%s: cannot write%s", tmp, "");
+            return 1;
+        }
+        for (int k = 0; k < n_names; k++) {
+            scene_ctx sc;
+            char path[PATH_MAX_LEN];
+            memset(&sc, 0, sizeof sc);
+            sc.o = &o;
+            snprintf(sc.name, sizeof sc.name, "%.*s", (int)(strlen(names[k]) - 6), names[k]);
+            if (!wanted(&o, sc.name))
+                continue;
+            snprintf(path, sizeof path, "%s/%s", o.scenes, names[k]);
+            sc.path = path;
+            snprintf(sc.dir, sizeof sc.dir, "%.3800s/%.255s", o.work, sc.name);
+            if (make_dir(sc.dir) != 0) {
+                say("%s: cannot create%s", sc.dir, "");
+                return 1;
+            }
+            fprintf(stderr, "speed_accuracy: %s\n", sc.name);
+            if (run_scene(&sc, &all, csv) != 0)
+                return 1;
+            fflush(csv);
+            rs_image_free(&sc.ref);
+        }
+        for (int k = 0; k < n_names; k++)
+            free(names[k]);
+        if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
+            say("%s: cannot write%s", csv_path, "");
+            return 1;
+        }
+    }
+    if (sa_chart_write(&all, o.docs, msg, sizeof msg) != 0) {
+        say("chart: %s%s", msg, "");
+        return 1;
+    }
+    sa_points_free(&all);
+    return 0;
+}
