@@ -12,4 +12,7 @@ for s in scenes/*.scene; do
 done
 build/bin/lensrender scenes/crossed_polarizers.scene -o docs/images/crossed_polarizers_fresnel.png \
     --width 320 --height 240 --mode fresnel --quiet
+# high interference orders need finer wavelength sampling than the default 16
+build/bin/lensrender scenes/michel_levy.scene -o docs/images/michel_levy.png \
+    --width 320 --height 240 --wavelengths 64 --quiet
 echo "render_examples: wrote docs/images/*.png"

@@ -45,6 +45,19 @@
  *                emits it as two coherent linear rays (part 0 and 1)
  *                along the axes of the polarization ellipse, each with
  *                its own `phase`.  Their amplitudes add to the exact field.
+ *   Crystals     in a lens of a uniaxial crystal every node splits the
+ *                light inside into an ordinary and an extraordinary ray
+ *                (up to four rays per node: two reflected, two
+ *                transmitted, the two on the isotropic side leaving as
+ *                one field), so the rays inside form a tree; op adds
+ *                K . s for each segment s (K the wave vector in units of
+ *                2 pi / lambda: n_o s for the o-ray, n(psi) cos(walk-off)
+ *                s for the e-ray).  The amplitudes at a crystal's surfaces
+ *                are complex and carried in vp and phase; kphi counts no
+ *                jumps there.  The o and e rays split from one ray keep
+ *                its ch: they are mutually coherent.  The modes fresnel
+ *                and schlick are laws of isotropic glass: a crystal is
+ *                always traced with the polarized law.
  *   Depth        counts interface interactions along a path: the external
  *                reflection has depth 1, a ray straight through depth 2.
  *
@@ -234,6 +247,55 @@ LP_API size_t lp_catalog_count(const lp_catalog *catalog);
 LP_API const char *lp_catalog_name(const lp_catalog *catalog, size_t i);
 
 /* ------------------------------------------------------------------ */
+/* Uniaxial crystals                                                   */
+/* ------------------------------------------------------------------ */
+
+/* A uniaxial crystal: an ordinary index n_o(lambda) and an extraordinary
+ * index n_e(lambda), each a glass (dispersion formula, and the
+ * absorption of the wave with its field across / along the optic axis),
+ * and the optic axis as a WORLD direction (any finite non-zero vector;
+ * the lens normalizes it; a lens at the origin along +z, as lenstrace
+ * has it, has its local frame equal to the world's).  A wave whose normal makes the angle
+ * psi with the axis has two modes: the ordinary wave of index n_o, field
+ * perpendicular to the plane (wave normal, axis), ray along the normal;
+ * and the extraordinary wave of index n(psi), 1/n^2 = cos^2(psi)/n_o^2 +
+ * sin^2(psi)/n_e^2, field in that plane, ray off the normal by the
+ * walk-off angle.  The e-wave's absorption is, to first order in the
+ * absorption, n(psi)^3 (cos^2 psi alpha_o/n_o^3 + sin^2 psi alpha_e/n_e^3)
+ * per mm along its ray.  Optical activity (quartz's rotation of the
+ * plane of polarization along its axis) is not modelled; biaxial crystals
+ * are not modelled. */
+typedef struct lp_crystal {
+    char name[LP_GLASS_NAME_MAX];
+    lp_glass ordinary;
+    lp_glass extraordinary;
+    lp_vec3 axis;
+} lp_crystal;
+
+/* Fill *crystal with constant, lossless indices n_o and n_e and the
+ * given axis (named "uniaxial"). */
+LP_API void lp_crystal_init_constant(lp_crystal *crystal, double n_o, double n_e,
+                                     lp_vec3 axis);
+
+/* Copy the built-in crystal `name` (case-insensitive) into *out, its axis
+ * set to +z (a c-cut plate of a lens along +z).  Built in, lossless, room
+ * temperature, o and e Sellmeier formulas (micrometres) as published and
+ * taken as relative to air:
+ *   "calcite"   CaCO3, Ghosh, Opt. Commun. 163, 95 (1999), 204-2172 nm
+ *   "quartz"    crystalline SiO2, Ghosh 1999, 198-2053 nm (no optical
+ *               activity: along its axis quartz rotates the plane of
+ *               polarization by ~22 deg/mm at 589 nm, which lensprim
+ *               leaves out)
+ *   "sapphire"  Al2O3, Malitson & Dodge, JOSA 62, 1405 (1972), 200-5000 nm
+ *   "MgF2"      Dodge, Appl. Opt. 23, 1980 (1984), 200-7000 nm
+ * LP_ERROR_UNKNOWN_GLASS for another name. */
+LP_API lp_status lp_crystal_builtin(const char *name, lp_crystal *out, lp_error *err);
+
+/* Check that a crystal can be used: both glasses pass lp_glass_check and
+ * the axis is a finite non-zero vector. */
+LP_API lp_status lp_crystal_check(const lp_crystal *crystal, lp_error *err);
+
+/* ------------------------------------------------------------------ */
 /* Lens                                                                */
 /* ------------------------------------------------------------------ */
 
@@ -247,12 +309,16 @@ typedef struct lp_lens_desc {
     double diameter2;  /* rim diameter at the back cap; 0 = diameter */
     lp_glass glass;
     lp_glass medium;   /* surrounding medium; default constant 1 (air) */
+    int uniaxial;      /* 1: the lens is of `crystal` (glass is ignored);
+                          0 (default): of the isotropic `glass` */
+    lp_crystal crystal;
     lp_vec3 position;  /* world position of the front vertex */
     lp_vec3 axis;      /* world direction of the local +z axis */
 } lp_lens_desc;
 
 /* Defaults: flat surfaces, thickness 0 (must be set), diameter 0 (must be
- * set), glass constant 1.5, medium constant 1, at the origin, axis +z. */
+ * set), glass constant 1.5, medium constant 1, at the origin, axis +z,
+ * not a crystal. */
 LP_API void lp_lens_desc_init(lp_lens_desc *desc);
 
 /* Create an immutable lens.  Refused with LP_ERROR_INVALID_LENS and a
@@ -328,6 +394,9 @@ typedef struct lp_out_ray {
     int surface;      /* LP_SURFACE_FRONT or LP_SURFACE_BACK */
     int part;         /* 0, or 1 for the second linear part after TIR */
     uint64_t path;    /* bit k-1 set when node k was a reflection */
+    uint64_t waves;   /* crystal lenses: bit k-1 set when the ray left
+                         node k inside the crystal as an extraordinary
+                         wave; 0 for a glass lens */
 } lp_out_ray;
 
 /* Warnings a trace can raise (bits of lp_result.warnings). */
@@ -441,6 +510,7 @@ typedef struct lp_query {
                          the exact transmittance. */
     double weight;    /* unpolarized transmittance estimate: the fresnel
                          (or schlick) product along the path */
+    uint64_t waves;   /* crystal lenses: as lp_out_ray.waves; 0 for glass */
 } lp_query;
 
 typedef struct lp_backward lp_backward;
@@ -462,7 +532,8 @@ LP_API size_t lp_backward_query_count(const lp_backward *bw);
 LP_API const lp_query *lp_backward_queries(const lp_backward *bw);
 
 /* Depth at which the view ray's chain met the rim (1 = the view ray hit
- * the rim itself), or 0 if it did not (within max_depth). */
+ * the rim itself), or 0 if it did not (within max_depth).  Through a
+ * crystal, the smallest depth at which a branch of its tree did. */
 LP_API int lp_backward_rim_depth(const lp_backward *bw);
 
 /* Phase 2, gather.  bundle[0..n) are linearly polarized rays arriving

@@ -43,6 +43,13 @@ static const char *const usage_text[] = {
 "                   glass   a catalog name (N-BK7, N-SF11, F2, ...) or\n"
 "                           n=1.5 for a constant index; the key n=1.5\n"
 "                           is accepted too                        required\n"
+"                   crystal instead of the glass, a uniaxial crystal: a\n"
+"                           built-in one (calcite, quartz, sapphire,\n"
+"                           MgF2), or no=N,ne=N for constant indices\n"
+"                   axis    the crystal's optic axis x:y:z in the lens\n"
+"                           frame (default 0:0:1); the output lines then\n"
+"                           carry \"waves\": bit k-1 set when the ray left\n"
+"                           node k inside as an extraordinary wave\n"
 "                   The lens sits in its local frame: axis +z, front vertex\n"
 "                   at the origin, back vertex at z = t.\n"
 "  --ray SPEC       space-separated KEY=VALUE, e.g.\n"
@@ -265,6 +272,8 @@ static void put_ray(outbuf *b, const lp_out_ray *r, const lp_query *query,
     }
     ob_printf(b, ",\"surface\":\"%s\",\"part\":%d,\"path\":%" PRIu64,
               surface_name(r->surface), r->part, r->path);
+    if (r->waves)
+        ob_printf(b, ",\"waves\":%" PRIu64, r->waves);
     if (half >= 0)
         ob_printf(b, ",\"half\":%d", half);
     if (index >= 0)
@@ -663,6 +672,30 @@ static int make_glass(run *r, const lp_catalog *catalog, lp_glass *glass)
     return 1;
 }
 
+/* Make the lens a uniaxial crystal; 0 and r->msg on error. */
+static int make_crystal(run *r, lp_lens_desc *desc)
+{
+    const lt_args *a = r->a;
+    lp_error err;
+    lp_status st = LP_OK;
+
+    memset(&err, 0, sizeof err);
+    desc->uniaxial = 1;
+    if (a->lens.crystal == 1)
+        st = lp_crystal_builtin(a->lens.crystal_name, &desc->crystal, &err);
+    else
+        lp_crystal_init_constant(&desc->crystal, a->lens.n_o, a->lens.n_e, a->lens.axis);
+    if (st == LP_OK) {
+        desc->crystal.axis = a->lens.axis;
+        st = lp_crystal_check(&desc->crystal, &err);
+    }
+    if (st != LP_OK) {
+        snprintf(r->msg, sizeof r->msg, "--lens: %s", lib_message(&err, st));
+        return 0;
+    }
+    return 1;
+}
+
 static int build_and_trace(run *r)
 {
     const lt_args *a = r->a;
@@ -709,7 +742,10 @@ static int build_and_trace(run *r)
     desc.thickness = a->lens.t;
     desc.diameter = a->lens.d;
     desc.diameter2 = a->lens.d2; /* 0 = not given = D */
-    if (!make_glass(r, catalog, &desc.glass))
+    if (a->lens.crystal) {
+        if (!make_crystal(r, &desc))
+            goto done;
+    } else if (!make_glass(r, catalog, &desc.glass))
         goto done;
     lp_glass_init_constant(&desc.medium, a->medium);
     st = lp_glass_check(&desc.medium, &err);

@@ -216,9 +216,28 @@ int lt_perpendicular_part(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
 /* --lens                                                              */
 /* ------------------------------------------------------------------ */
 
-enum { LK_R1, LK_R2, LK_T, LK_D, LK_D2, LK_GLASS, LK_N, LK_COUNT };
-static const char *const lens_keys[LK_COUNT] = {"R1", "R2", "t", "D",
-                                                "D2", "glass", "n"};
+enum { LK_R1, LK_R2, LK_T, LK_D, LK_D2, LK_GLASS, LK_N, LK_CRYSTAL, LK_NO, LK_NE,
+       LK_AXIS, LK_COUNT };
+static const char *const lens_keys[LK_COUNT] = {"R1", "R2", "t", "D", "D2", "glass",
+                                                "n", "crystal", "no", "ne", "axis"};
+
+/* axis=x:y:z (the --lens items are comma-separated) */
+static const char *parse_axis(lt_args *args, const char *val, lp_vec3 *out)
+{
+    char buf[LT_TOKEN_MAX];
+    size_t n = strlen(val);
+    if (n >= sizeof buf)
+        return fail(args, "--lens: axis: value is too long");
+    for (size_t i = 0; i <= n; i++)
+        buf[i] = val[i] == ':' ? ',' : val[i];
+    if (!strchr(val, ':'))
+        return fail(args, "--lens: axis: expected x:y:z, got '%s'", val);
+    if (parse_vec3(args, "axis", buf, out))
+        return args->error;
+    if (out->x == 0.0 && out->y == 0.0 && out->z == 0.0)
+        return fail(args, "--lens: axis: the optic axis must not be the zero vector");
+    return NULL;
+}
 
 static const char *lens_value(lt_args *args, int key, const char *val,
                               lt_lens_spec *out)
@@ -232,6 +251,21 @@ static const char *lens_value(lt_args *args, int key, const char *val,
     case LK_N:
         out->glass_constant = 1;
         return parse_positive(args, "--lens", "n", val, &out->glass_n);
+    case LK_CRYSTAL:
+        if (*val == '\0' || strlen(val) >= sizeof out->crystal_name)
+            return fail(args, "--lens: crystal: give a built-in name (calcite, quartz, "
+                              "sapphire, MgF2)");
+        out->crystal = 1;
+        strcpy(out->crystal_name, val);
+        return NULL;
+    case LK_NO:
+        out->crystal = 2;
+        return parse_positive(args, "--lens", "no", val, &out->n_o);
+    case LK_NE:
+        out->crystal = 2;
+        return parse_positive(args, "--lens", "ne", val, &out->n_e);
+    case LK_AXIS:
+        return parse_axis(args, val, &out->axis);
     case LK_GLASS:
         if (strncmp(val, "n=", 2) == 0) {
             out->glass_constant = 1;
@@ -259,6 +293,7 @@ const char *lt_parse_lens_spec(lt_args *args, const char *spec,
     const char *p = spec;
 
     memset(&s, 0, sizeof s);
+    s.axis.z = 1.0;
     for (;;) {
         const char *e = strchr(p, ',');
         const char *eq;
@@ -292,7 +327,7 @@ const char *lt_parse_lens_spec(lt_args *args, const char *spec,
                 key = k;
         if (key < 0)
             return fail(args, "--lens: unknown key '%s' (keys: R1, R2, t, D, "
-                              "D2, glass, n)", item);
+                              "D2, glass, n, crystal, no, ne, axis)", item);
         if (seen[key])
             return fail(args, "--lens: duplicate key '%s'", item);
         if ((key == LK_GLASS && seen[LK_N]) || (key == LK_N && seen[LK_GLASS]))
@@ -305,8 +340,22 @@ const char *lt_parse_lens_spec(lt_args *args, const char *spec,
             break;
         p = e + 1;
     }
+    int glassy = seen[LK_GLASS] || seen[LK_N];
+    int crystal = seen[LK_CRYSTAL] || seen[LK_NO] || seen[LK_NE];
+    if (glassy && crystal)
+        return fail(args, "--lens: give either a glass (glass=, n=) or a crystal "
+                          "(crystal=, or no= and ne=), not both");
+    if (seen[LK_CRYSTAL] && (seen[LK_NO] || seen[LK_NE]))
+        return fail(args, "--lens: give either crystal=NAME or no= and ne=, not both");
+    if ((seen[LK_NO] || seen[LK_NE]) && !(seen[LK_NO] && seen[LK_NE]))
+        return fail(args, "--lens: a constant crystal needs both no= and ne=");
+    if (seen[LK_AXIS] && !crystal)
+        return fail(args, "--lens: axis= is the optic axis of a crystal (crystal= or "
+                          "no=,ne=)");
+    if (crystal)
+        seen[LK_GLASS] = 1; /* the crystal stands for the glass */
     for (int k = 0; k < LK_COUNT; k++) {
-        if (k == LK_D2 || k == LK_GLASS || k == LK_N)
+        if (k == LK_D2 || k == LK_GLASS || k == LK_N || k >= LK_CRYSTAL)
             continue;
         if (!seen[k])
             return fail(args, "--lens: missing key '%s' (required: R1, R2, "

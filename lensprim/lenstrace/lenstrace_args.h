@@ -25,7 +25,9 @@
  * standard air, lp_air_index, begins. */
 #define LT_LAMBDA_MIN_NM 160.0
 
-/* --lens "R1=..,R2=..,t=..,D=..,D2=..,glass=NAME|n=N" (or n=N as a key) */
+/* --lens "R1=..,R2=..,t=..,D=..,D2=..,glass=NAME|n=N" (or n=N as a key),
+ * or instead of the glass a uniaxial crystal: crystal=NAME (built-in) or
+ * no=N,ne=N, with axis=x:y:z */
 typedef struct lt_lens_spec {
     double r1, r2;        /* mm; 0 or +-inf = flat */
     double t;             /* centre thickness, mm, finite > 0 */
@@ -34,6 +36,10 @@ typedef struct lt_lens_spec {
     int glass_constant;   /* 1: glass_n is a constant index */
     double glass_n;       /* finite > 0 when glass_constant */
     char glass_name[LT_GLASS_NAME_MAX]; /* catalog name when !glass_constant */
+    int crystal;          /* 0: glass; 1: built-in crystal_name; 2: no/ne */
+    char crystal_name[LT_GLASS_NAME_MAX];
+    double n_o, n_e;      /* crystal == 2: constant indices */
+    lp_vec3 axis;         /* optic axis, lens frame (default 0,0,1) */
 } lt_lens_spec;
 
 /* --ray "o=x,y,z d=x,y,z lambda=NM vp=x,y,z|unpolarized I=.. ch=.."

@@ -60,7 +60,11 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_lens_create: NULL argument");
     if ((st = check_shape(desc, err)) != LP_OK)
         return st;
-    if ((st = lp_glass_check(&desc->glass, err)) != LP_OK)
+    if (desc->uniaxial != 0 && desc->uniaxial != 1)
+        return lp__fail(err, LP_ERROR_INVALID_LENS, "uniaxial must be 0 or 1, got %d",
+                        desc->uniaxial);
+    if ((st = desc->uniaxial ? lp_crystal_check(&desc->crystal, err)
+                             : lp_glass_check(&desc->glass, err)) != LP_OK)
         return st;
     if ((st = lp_glass_check(&desc->medium, err)) != LP_OK)
         return st;
@@ -99,6 +103,8 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
         return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory creating a lens");
     lens->desc = *desc;
     lens->desc.diameter2 = 2.0 * h2;
+    if (desc->uniaxial)
+        lens->desc.crystal.axis = v3_normalize(desc->crystal.axis);
     lens->cap[LP_SURFACE_FRONT] = (lp__cap){c1, 0.0, h1, +1.0};
     lens->cap[LP_SURFACE_BACK] = (lp__cap){c2, t, h2, -1.0};
 
@@ -147,6 +153,8 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
     lens->desc.axis = lens->w;
     lens->u = v3_any_perp(lens->w);
     lens->v = v3_cross(lens->w, lens->u);
+    if (desc->uniaxial)
+        lens->crystal_axis = lp__to_local_dir(lens, lens->desc.crystal.axis);
     *out = lens;
     lp__ok(err);
     return LP_OK;

@@ -35,6 +35,7 @@ struct lp_lens {
     double scale;     /* a size of the lens, mm */
     double eps;       /* distance below which a hit on ANOTHER surface
                          than the one a ray leaves is ignored */
+    lp_vec3 crystal_axis; /* a crystal's optic axis, local, unit */
 };
 
 /* A hit in the local frame. */

@@ -37,6 +37,26 @@ lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_v
                    lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
                    uint64_t path, lp_error *err);
 
+/* Send one outgoing field (branch b, leaving the local point p) to the
+ * result, or count its power as skipped when args' flags or filter
+ * decline it. */
+struct lp__branch;
+lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
+                    const struct lp__branch *b, lp_vec3 p, const lp__payload *pl, int depth,
+                    lp_kind kind, int surface, uint64_t path, lp_error *err);
+
+/* Check a bundle ray of lp_backward_gather and give its field direction
+ * in the lens frame, perpendicular to the local light direction. */
+lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,
+                               lp_vec3 *vp, lp_error *err);
+
+/* Emit a gathered field E (of a bundle ray of power `in`, of which
+ * `absorbed` went into the glass) as the rays of query q, leaving the
+ * local point p along d; the rest of `in` is counted as truncated. */
+lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
+                            lp_vec3 d, const lp__payload *pl, const lp_query *q, double in,
+                            double absorbed, lp_error *err);
+
 /* Make v a unit vector perpendicular to the unit d; 0 if impossible. */
 int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out);
 

@@ -16,6 +16,7 @@
 #include "error.h"
 #include "interface.h"
 #include "trace.h"
+#include "trace_crystal.h"
 
 typedef struct bw_node {
     lp_vec3 p;       /* local point */
@@ -37,6 +38,7 @@ struct lp_backward {
     lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
     int rim_depth;
     unsigned warnings;
+    lp__xback *xb;                 /* the last build's, through a crystal */
 };
 
 lp_status lp_backward_create(lp_backward **out, lp_error *err)
@@ -52,21 +54,29 @@ lp_status lp_backward_create(lp_backward **out, lp_error *err)
 
 void lp_backward_destroy(lp_backward *bw)
 {
+    if (bw)
+        lp__xback_free(bw->xb);
     free(bw);
 }
 
 size_t lp_backward_query_count(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_query_count(bw->xb);
     return bw ? bw->n_queries : 0;
 }
 
 const lp_query *lp_backward_queries(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_queries(bw->xb);
     return bw ? bw->query : NULL;
 }
 
 int lp_backward_rim_depth(const lp_backward *bw)
 {
+    if (bw && lp__xback_active(bw->xb))
+        return lp__xback_rim_depth(bw->xb);
     return bw ? bw->rim_depth : 0;
 }
 
@@ -105,6 +115,7 @@ static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_
     q->op = op;
     q->bound = bound;
     q->weight = weight;
+    q->waves = 0;
     if (bound < bw->args.min_weight)
         return;
     info.depth = depth;
@@ -135,6 +146,7 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     bw->warnings = 0;
     if ((st = lp__args_resolve(args, &bw->args, err)) != LP_OK)
         return st;
+    lp__xback_deactivate(bw->xb);
     if (!v3_finite(origin) || !v3_finite(dir))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "view ray is not finite");
     lp_vec3 dw = v3_normalize(dir);
@@ -157,6 +169,8 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
         lp__ok(err);
         return LP_OK;
     }
+    if (lens->desc.uniaxial)
+        return lp__crystal_build(&bw->xb, lens, &bw->optics, &bw->args, d, &h, err);
 
     int entry = h.surface;
     bw->n_nodes = 1;
@@ -235,14 +249,9 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, l
     lp_vec3 vp;
     int k = q->depth;
 
-    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
-        !isfinite(b->phase))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
-    if (!v3_finite(b->vp) ||
-        !lp__perp_unit(lp__to_local_dir(bw->lens, b->vp), light, &vp))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray polarization must be finite and not parallel to the query ray");
+    lp_status st0 = lp__bundle_ray_check(bw->lens, b, light, &vp, err);
+    if (st0 != LP_OK)
+        return st0;
 
     double I0 = b->intensity;
     lp__cvec3 E = cv3_real(vp, sqrt(I0));
@@ -277,14 +286,8 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, l
         }
     }
     res->nodes += (size_t)k;
-    double before = res->out;
-    lp_status st = lp__emit(bw->lens, res, &E, bw->node[1].p, v3_neg(bw->view_dir), &pl, k,
-                            q->kind, q->surface, q->path, err);
-    if (st != LP_OK)
-        return st;
-    res->absorbed_glass += absorbed;
-    res->truncated += I0 - (res->out - before) - absorbed;
-    return LP_OK;
+    return lp__emit_gathered(bw->lens, res, &E, bw->node[1].p, v3_neg(bw->view_dir), &pl, q,
+                             I0, absorbed, err);
 }
 
 lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
@@ -293,6 +296,8 @@ lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bund
     lp_status st;
     if (!bw || !out || (!bundle && n > 0))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_gather: NULL argument");
+    if (lp__xback_active(bw->xb))
+        return lp__crystal_gather(bw->xb, q, bundle, n, out, err);
     if (q >= bw->n_queries)
         return lp__fail(err, LP_ERROR_RANGE, "query %zu does not exist (%zu queries)", q,
                         bw->n_queries);

@@ -6,6 +6,7 @@
 #include "polarization.h"
 #include "result.h"
 #include "trace.h"
+#include "interface.h"
 
 lp_status lp__optics_at(const lp_lens *lens, double lambda_nm, lp__optics *o, lp_error *err)
 {
@@ -13,20 +14,23 @@ lp_status lp__optics_at(const lp_lens *lens, double lambda_nm, lp__optics *o, lp
     if (!isfinite(lambda_nm) || !(lambda_nm > 0.0))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
                         "wavelength %g nm must be a finite number > 0", lambda_nm);
+    /* a crystal's ordinary glass stands for it here (trace_crystal.c
+     * adds the extraordinary one) */
+    const lp_glass *g = d->uniaxial ? &d->crystal.ordinary : &d->glass;
     o->lambda_nm = lambda_nm;
-    o->n_glass = lp_glass_index(&d->glass, lambda_nm);
+    o->n_glass = lp_glass_index(g, lambda_nm);
     o->n_medium = lp_glass_index(&d->medium, lambda_nm);
-    o->alpha = lp_glass_absorption(&d->glass, lambda_nm);
+    o->alpha = lp_glass_absorption(g, lambda_nm);
     if (!isfinite(o->n_glass) || !(o->n_glass > 0.0))
         return lp__fail(err, LP_ERROR_INVALID_GLASS, "glass %s has no valid index at %g nm",
-                        d->glass.name, lambda_nm);
+                        g->name, lambda_nm);
     if (!isfinite(o->n_medium) || !(o->n_medium > 0.0))
         return lp__fail(err, LP_ERROR_INVALID_GLASS,
                         "medium %s has no valid index at %g nm", d->medium.name, lambda_nm);
     if (!isfinite(o->alpha) || o->alpha < 0.0)
         o->alpha = 0.0;
     o->warnings = 0;
-    if (!lp_glass_covers(&d->glass, lambda_nm) || !lp_glass_covers(&d->medium, lambda_nm))
+    if (!lp_glass_covers(g, lambda_nm) || !lp_glass_covers(&d->medium, lambda_nm))
         o->warnings |= LP_WARN_EXTRAPOLATED;
     return LP_OK;
 }
@@ -109,7 +113,58 @@ lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_v
         o->surface = surface;
         o->part = k;
         o->path = path;
+        o->waves = 0;
         res->out += part[k].intensity;
     }
+    return LP_OK;
+}
+
+/* Send one outgoing field to the result, or count it as skipped. */
+lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
+                    const lp__branch *b, lp_vec3 p, const lp__payload *pl, int depth,
+                    lp_kind kind, int surface, uint64_t path, lp_error *err)
+{
+    lp_branch_info info;
+    double power = cv3_norm2(b->E);
+
+    info.depth = depth;
+    info.kind = kind;
+    info.surface = surface;
+    info.origin = lp__to_world_point(lens, p);
+    info.dir = lp__to_world_dir(lens, b->dir);
+    info.bound = power;
+    if (!lp__args_keep(a, &info)) {
+        res->skipped += power;
+        return LP_OK;
+    }
+    return lp__emit(lens, res, &b->E, p, b->dir, pl, depth, kind, surface, path, err);
+}
+
+lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,
+                               lp_vec3 *vp, lp_error *err)
+{
+    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
+        !isfinite(b->phase))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
+    if (!v3_finite(b->vp) || !lp__perp_unit(lp__to_local_dir(lens, b->vp), light, vp))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                        "bundle ray polarization must be finite and not parallel to the query ray");
+    return LP_OK;
+}
+
+lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
+                            lp_vec3 d, const lp__payload *pl, const lp_query *q, double in,
+                            double absorbed, lp_error *err)
+{
+    double before = res->out;
+    size_t first = res->count;
+    lp_status st = lp__emit(lens, res, E, p, d, pl, q->depth, q->kind, q->surface, q->path, err);
+    if (st != LP_OK)
+        return st;
+    for (size_t i = first; i < res->count; i++)
+        res->rays[i].waves = q->waves;
+    res->absorbed_glass += absorbed;
+    res->truncated += in - (res->out - before) - absorbed;
     return LP_OK;
 }

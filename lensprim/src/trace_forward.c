@@ -11,27 +11,7 @@
 #include "error.h"
 #include "interface.h"
 #include "trace.h"
-
-/* Send one outgoing field to the result, or count it as skipped. */
-static lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
-                       const lp__branch *b, lp_vec3 p, const lp__payload *pl, int depth,
-                       lp_kind kind, int surface, uint64_t path, lp_error *err)
-{
-    lp_branch_info info;
-    double power = cv3_norm2(b->E);
-
-    info.depth = depth;
-    info.kind = kind;
-    info.surface = surface;
-    info.origin = lp__to_world_point(lens, p);
-    info.dir = lp__to_world_dir(lens, b->dir);
-    info.bound = power;
-    if (!lp__args_keep(a, &info)) {
-        res->skipped += power;
-        return LP_OK;
-    }
-    return lp__emit(lens, res, &b->E, p, b->dir, pl, depth, kind, surface, path, err);
-}
+#include "trace_crystal.h"
 
 static lp_status check_ray(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err)
 {
@@ -83,6 +63,8 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
 
     lp__payload pl = {in->lambda_nm, in->kphi, in->op, in->phase, in->ch};
     lp__cvec3 E = cv3_real(lp__to_local_dir(lens, vpw), sqrt(I0));
+    if (lens->desc.uniaxial)
+        return lp__crystal_forward(lens, &o, a, &h, d, &E, &pl, res, err);
     int entry = h.surface, depth = 1;
     uint64_t path = 0;
 
@@ -93,7 +75,7 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
     {
         lp__payload pr = pl;
         pr.kphi += refl.flip;
-        st = leave(lens, a, res, &refl, h.p, &pr, 1, LP_KIND_REFLECT, h.surface, path | 1u, err);
+        st = lp__leave(lens, a, res, &refl, h.p, &pr, 1, LP_KIND_REFLECT, h.surface, path | 1u, err);
         if (st != LP_OK)
             return st;
     }
@@ -135,7 +117,7 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
         if (!tir) {
             lp__node_transmit(&node, a->mode, &E, &trans);
             lp_kind kind = surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
-            st = leave(lens, a, res, &trans, p, &pl, depth, kind, surface, path, err);
+            st = lp__leave(lens, a, res, &trans, p, &pl, depth, kind, surface, path, err);
             if (st != LP_OK)
                 return st;
         }

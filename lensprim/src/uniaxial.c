@@ -244,10 +244,8 @@ void lp__xnode_setup(lp__xnode *x, const lp__medium *a, const lp__medium *b, int
     double q_inc = fabs(v3_dot(K_inc, N));
     int e_inc = a->uniaxial && inc_kind == LP__WAVE_E;
     double base = e_inc ? v3_dot(K_inc, K_inc) : a->no * a->no;
-    if (x->kt.x == 0.0 && x->kt.y == 0.0 && x->kt.z == 0.0) {
-        base = 0.0;
-        q_inc = 0.0;
-    }
+    if (x->kt.x == 0.0 && x->kt.y == 0.0 && x->kt.z == 0.0)
+        base = q_inc * q_inc; /* |kt|^2 = 0 exactly */
     waves(a, x->kt, base, q_inc, v3_neg(N), x->t1, e_inc ? q_inc : -1.0, 0, &x->out[0]);
     waves(b, x->kt, base, q_inc, N, x->t1, -1.0, 0, &x->out[2]);
     /* the incident waves of this frame: s/p, or o/e of the incident K */

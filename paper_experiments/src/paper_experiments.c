@@ -165,11 +165,12 @@ static int load_lenses(ex_ctx *ctx, const char *dir)
             rc = -1;
         }
         int k = 0, count = 0;
+        /* the paper's lens is of glass: crystal specimens are left out */
         for (size_t j = 0; rc == 0 && j < scene.n_objects; j++)
-            count += scene.objects[j].type == RS_OBJ_LENS;
+            count += scene.objects[j].type == RS_OBJ_LENS && !scene.objects[j].u.lens.desc.uniaxial;
         for (size_t j = 0; rc == 0 && j < scene.n_objects; j++) {
             const rs_object *o = &scene.objects[j];
-            if (o->type != RS_OBJ_LENS || ctx->n_lens >= EX_LENS_MAX)
+            if (o->type != RS_OBJ_LENS || o->u.lens.desc.uniaxial || ctx->n_lens >= EX_LENS_MAX)
                 continue;
             ex_lens *l = &ctx->lens[ctx->n_lens++];
             int base = (int)(strlen(names[i]) - 6);

@@ -35,6 +35,15 @@ uint64_t rs_coherence_ch(long index, int source, int half)
     return ((uint64_t)index << 32) | (2u * (uint64_t)source + (uint64_t)half);
 }
 
+#define RS_COH_SPLIT 0x80000000u
+#define RS_COH_SOURCE 0xffffu
+
+uint64_t rs_coherence_split(uint64_t ch, uint64_t hit, int depth, int transmit)
+{
+    uint64_t group = ((hit & 0xff) << 7 | (uint64_t)(depth & 0x3f) << 1 | (transmit != 0)) & 0x7fff;
+    return (ch & ~(uint64_t)0xffff0000u) | RS_COH_SPLIT | group << 16;
+}
+
 static double dot3(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 static lp_vec3 sub3(lp_vec3 a, lp_vec3 b) { return (lp_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
 
@@ -80,10 +89,12 @@ double rs_coherent_power(const lp_ray *r, size_t n, const rs_wavelets *t,
     for (size_t i = 0; i < n; i++) {
         const lp_ray *a = &r[i];
         total += a->intensity;
-        uint64_t ca = a->ch & RS_COH_LOW, src = ca / 2, ia = a->ch >> 32;
-        if (src >= (uint64_t)n_sources || !coherent[src] || a->intensity == 0.0 || ia >= t->n)
+        uint64_t ca = a->ch & RS_COH_LOW, src = (ca & RS_COH_SOURCE) / 2, ia = a->ch >> 32;
+        int split = (ca & RS_COH_SPLIT) != 0;
+        if (src >= (uint64_t)n_sources || !(coherent[src] || split) || a->intensity == 0.0 ||
+            ia >= t->n)
             continue;
-        double lc = coherence[src];
+        double lc = coherent[src] ? coherence[src] : 0.0;
         for (size_t j = i + 1; j < n; j++) {
             const lp_ray *b = &r[j];
             uint64_t ib = b->ch >> 32;

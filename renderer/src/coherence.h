@@ -61,6 +61,21 @@ void rs_wavelets_free(rs_wavelets *t);
 /* The ch of a ray of source `source`, half `half`, leaving wavelet `index`. */
 uint64_t rs_coherence_ch(long index, int source, int half);
 
+/* Rays a crystal lens splits into o and e rays.  The rays one lens hit
+ * returns on queries of one depth and kind, grown from one channel, come
+ * from that source: their wavelets are joined to a common source point
+ * like any pair's, and they are mutually coherent whatever the source's
+ * `coherent` setting (natural white light gives the interference colours
+ * of a crystal); different source points (emitters) and the two halves
+ * of natural light still add as intensities.  rs_coherence_split marks
+ * such a ray: bit 31 of ch set, bits 16-30 a number of the group (the lens
+ * hit's number `hit`, the depth and kind of its query), the source and
+ * half in bits 0-15, the wavelet index kept.  Channels of a split group
+ * are coherent with coherence length 0 (infinite) unless their source is
+ * coherent.  Valid when 2 * sources < 2^16. */
+#define RS_COHERENCE_MAX_SOURCES 32768
+uint64_t rs_coherence_split(uint64_t ch, uint64_t hit, int depth, int transmit);
+
 /* What the pixel receives from rays r[0..n) of one wavelength (nm, in
  * air): rays of different channels, or of a channel that is not coherent,
  * add as intensities; two rays of one coherent channel (coherent[src]) add

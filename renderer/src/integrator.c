@@ -87,6 +87,7 @@ struct rs_worker {
     frame *frames[RS_MAX_FRAMES];
     bundle pixel;
     rs_wavelets wavelets; /* of the band being traced (coherence.h) */
+    uint64_t splits;      /* crystal lens hits, for rs_coherence_split */
 };
 
 /* Source ids: 0 ambient, 1 background, 2 + k light k, 2 + L + i object i. */
@@ -729,6 +730,7 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
             return;
         size_t nq = lp_backward_query_count(fr->bw);
         const lp_query *q = lp_backward_queries(fr->bw);
+        uint64_t hit = ++w->splits;
         for (size_t k = 0; k < nq; k++) {
             fr->child.n = 0;
             trace_pol(w, b, q[k].origin, q[k].dir, level + q[k].depth, weight * q[k].bound, -1,
@@ -738,11 +740,14 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
             lp_result_clear(&fr->res);
             if (lp_backward_gather(fr->bw, k, fr->child.r, fr->child.n, &fr->res, NULL) != LP_OK)
                 continue;
+            int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
             for (size_t i = 0; i < fr->res.count; i++) {
                 lp_ray *r = bundle_push(out);
                 if (!r)
                     return;
                 *r = fr->res.rays[i].ray;
+                if (split)
+                    r->ch = rs_coherence_split(r->ch, hit, q[k].depth, q[k].kind != LP_KIND_REFLECT);
             }
         }
         shift_op(out, start, h.t);

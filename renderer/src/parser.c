@@ -180,7 +180,7 @@ static const char *const reserved_words[] = {
     "coherent", "background", "global_settings", "max_trace_level", "adc_bailout",
     "ambient_light", "assumed_gamma", "plane", "sphere", "box", "disc", "lens", "radius1",
     "radius2", "thickness", "diameter", "diameter2", "glass", "ior", "sellmeier", "medium",
-    "polarizer", "center", "normal", "radius", "axis", "pigment", "finish", "texture",
+    "uniaxial", "crystal", "ordinary", "extraordinary", "polarizer", "center", "normal", "radius", "axis", "pigment", "finish", "texture",
     "checker", "color", "colour", "rgb", "rgbf", "rgbt", "rgbft", "red", "green", "blue",
     "filter", "transmit", "ambient", "diffuse", "emission", "specular", "phong",
     "phong_size", "brilliance", "roughness", "reflection", "conserve_energy", "metallic",
@@ -1742,13 +1742,75 @@ static int check_glass(parser *p, const rs_token *at, const lp_glass *g)
     return 0;
 }
 
+/* The lens is of a uniaxial crystal (the token g, 'uniaxial' or 'crystal'
+ * is taken):
+ *   uniaxial { ordinary N extraordinary N axis <x, y, z> }   constant indices
+ *   crystal "NAME" [axis <x, y, z>]                          built in
+ * The axis (default <0, 0, 1>) is in the lens's frame; *axis receives it
+ * for the lens's transforms. */
+static int parse_crystal(parser *p, lp_lens_desc *d, const rs_token *g, lp_vec3 *axis)
+{
+    lp_error err;
+    *axis = (lp_vec3){ 0.0, 0.0, 1.0 };
+    d->uniaxial = 1;
+    if (is_id(g, "crystal")) {
+        char name[LP_GLASS_NAME_MAX];
+        const rs_token *s = peek(p);
+        if (s->kind != RS_TOK_STRING)
+            return expected(p, s, "a crystal name in quotes after 'crystal'");
+        if (rs_string_decode(s, name, sizeof name) < 0 ||
+            lp_crystal_builtin(name, &d->crystal, &err) != LP_OK)
+            return error_at(p, s->line, s->column, "lens: %s",
+                            s->len >= LP_GLASS_NAME_MAX ? "crystal name too long" : err.message);
+        take(p);
+        if (is_id(peek(p), "axis")) {
+            take(p);
+            if (parse_nonzero_vector(p, "the crystal axis", axis) != 0)
+                return -1;
+        }
+        return 0;
+    }
+    double no = 0.0, ne = 0.0;
+    if (open_block(p, "uniaxial") != 0)
+        return -1;
+    for (;;) {
+        const rs_token *t = peek(p);
+        if (is_punct(t, '}'))
+            break;
+        if (is_id(t, "ordinary")) {
+            take(p);
+            if (parse_positive(p, "ordinary", &no) != 0)
+                return -1;
+        } else if (is_id(t, "extraordinary")) {
+            take(p);
+            if (parse_positive(p, "extraordinary", &ne) != 0)
+                return -1;
+        } else if (is_id(t, "axis")) {
+            take(p);
+            if (parse_nonzero_vector(p, "the crystal axis", axis) != 0)
+                return -1;
+        } else {
+            return expected(p, t, "ordinary, extraordinary, axis or '}' in uniaxial");
+        }
+    }
+    if (!(no > 0.0) || !(ne > 0.0))
+        return error_at(p, g->line, g->column, "uniaxial: missing %s index",
+                        no > 0.0 ? "the extraordinary" : "the ordinary");
+    if (close_block(p, "uniaxial") != 0)
+        return -1;
+    lp_crystal_init_constant(&d->crystal, no, ne, *axis);
+    if (lp_crystal_check(&d->crystal, &err) != LP_OK)
+        return error_at(p, g->line, g->column, "lens: %s", err.message);
+    return 0;
+}
+
 static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
 {
     lp_lens_desc *d = &o->u.lens.desc;
     rs_transform xf;
     int have_r1 = 0, have_r2 = 0, have_t = 0, have_d = 0, have_glass = 0;
     double k, r1, r2;
-    lp_vec3 axis;
+    lp_vec3 axis, crystal_axis = { 0.0, 0.0, 1.0 };
 
     lp_lens_desc_init(d);
     o->u.lens.glass_name[0] = '\0';
@@ -1825,6 +1887,15 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
                 if (check_glass(p, &g, &d->glass) != 0)
                     return -1;
             }
+        } else if (is_id(t, "uniaxial") || is_id(t, "crystal")) {
+            rs_token g = take(p);
+            if (have_glass)
+                return error_at(p, g.line, g.column,
+                                "lens: the glass is already given (use one of glass, ior, "
+                                "sellmeier, uniaxial, crystal)");
+            have_glass = 1;
+            if (parse_crystal(p, d, &g, &crystal_axis) != 0)
+                return -1;
         } else if (is_id(t, "medium")) {
             rs_token m = take(p);
             double n;
@@ -1848,14 +1919,14 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
                 return -1;
         } else {
             return expected(p, t, "radius1, radius2, thickness, diameter, diameter2, glass, "
-                                  "ior, sellmeier, medium, translate, rotate, scale or '}' "
-                                  "in lens");
+                                  "ior, sellmeier, uniaxial, crystal, medium, translate, "
+                                  "rotate, scale or '}' in lens");
         }
     }
     if (!have_r1 || !have_r2 || !have_t || !have_d || !have_glass) {
         const char *missing = !have_r1 ? "radius1" : !have_r2 ? "radius2"
                             : !have_t ? "thickness" : !have_d ? "diameter"
-                            : "a glass (glass \"NAME\", ior or sellmeier)";
+                            : "a glass (glass \"NAME\", ior, sellmeier, uniaxial or crystal)";
         return error_at(p, kw->line, kw->column, "lens: missing %s", missing);
     }
     if (close_block(p, "lens") != 0)
@@ -1872,9 +1943,12 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
     d->position = rs_xf_point(&xf, (lp_vec3){ 0.0, 0.0, 0.0 });
     axis = rs_xf_dir(&xf, (lp_vec3){ 0.0, 0.0, 1.0 });
     d->axis = (lp_vec3){ axis.x / k, axis.y / k, axis.z / k };
+    if (d->uniaxial)
+        d->crystal.axis = rs_xf_dir(&xf, crystal_axis); /* lensprim wants it in the world */
     if ((isfinite(r1) && !isfinite(d->radius1)) || (isfinite(r2) && !isfinite(d->radius2)) ||
         !isfinite(d->thickness) || !isfinite(d->diameter) || !isfinite(d->diameter2) ||
-        !vec_finite(d->position) || !vec_finite(d->axis))
+        !vec_finite(d->position) || !vec_finite(d->axis) ||
+        (d->uniaxial && !vec_finite(d->crystal.axis)))
         return error_at(p, kw->line, kw->column,
                         "lens: a value is not finite after the transforms");
     if ((r1 != 0.0 && d->radius1 == 0.0) || (r2 != 0.0 && d->radius2 == 0.0))

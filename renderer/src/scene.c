@@ -154,6 +154,14 @@ int rs_scene_freeze_glass(rs_scene *scene, double lambda_nm, char *msg, size_t m
             return prep_error(msg, msg_size, &o->loc, "lens: no index at %g nm", lambda_nm);
         lp_glass_init_constant(&d->glass, ng);
         lp_glass_init_constant(&d->medium, nm);
+        if (d->uniaxial) {
+            double no = lp_glass_index(&d->crystal.ordinary, lambda_nm);
+            double ne = lp_glass_index(&d->crystal.extraordinary, lambda_nm);
+            if (!isfinite(no) || !isfinite(ne))
+                return prep_error(msg, msg_size, &o->loc, "lens: no crystal index at %g nm",
+                                  lambda_nm);
+            lp_crystal_init_constant(&d->crystal, no, ne, d->crystal.axis);
+        }
         o->u.lens.glass_name[0] = '\0';
         lp_lens_destroy(o->lens);
         o->lens = NULL;

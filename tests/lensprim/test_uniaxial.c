@@ -337,6 +337,21 @@ static void test_a_cut(void)
         lp__cvec3 Wo = cv3_real(o, v3_dot(E, o) * to), We = cv3_real(c, v3_dot(E, c) * te);
         CHECK_ABS(cdist(Eo, Wo), 0.0, 1e-14, "a-cut o by projection at %d deg", i * 5);
         CHECK_ABS(cdist(Ee, We), 0.0, 1e-14, "a-cut e by projection at %d deg", i * 5);
+        /* and out again at normal incidence: each wave transmits t(n)^2
+         * of its power and reflects the rest into itself */
+        for (int w = 0; w < 2; w++) {
+            double n = w ? ne : no;
+            lp_vec3 e = w ? c : o;
+            lp__xnode y;
+            lp__xnode_setup(&y, &X, &A, w ? LP__WAVE_E : LP__WAVE_O, v3(0, 0, n), N, e);
+            lp__cvec3 in = cv3_real(e, 1.0), out[4];
+            CHECK(lp__xnode_apply(&y, &in, out) == 0, "solve");
+            double T = cv3_norm2(out[2]) + cv3_norm2(out[3]);
+            double R = ((n - 1) / (n + 1)) * ((n - 1) / (n + 1));
+            CHECK_ABS(T, 1 - R, 1e-14, "a-cut exit T of the %c wave", w ? 'e' : 'o');
+            CHECK_ABS(cv3_norm2(out[w]), R, 1e-14, "a-cut exit R of the %c wave",
+                      w ? 'e' : 'o');
+        }
     }
 }
 

@@ -1088,6 +1088,14 @@ static void test_errors(void)
     const char *L = LENS;
     const char *Y = AXIAL;
     BAD("nan", "NaN in o", "--lens", L, "--ray", "o=0,nan,-10 d=0,0,1");
+    BAD("topaz", "unknown crystal", "--lens", "R1=0,R2=0,t=1,D=10,crystal=topaz", "--ray", Y);
+    BAD("not both", "glass and crystal", "--lens", "R1=0,R2=0,t=1,D=10,glass=N-BK7,no=1.6,ne=1.5",
+        "--ray", Y);
+    BAD("ne", "no without ne", "--lens", "R1=0,R2=0,t=1,D=10,no=1.6", "--ray", Y);
+    BAD("axis", "zero optic axis", "--lens", "R1=0,R2=0,t=1,D=10,crystal=quartz,axis=0:0:0",
+        "--ray", Y);
+    BAD("axis", "axis without a crystal", "--lens", "R1=0,R2=0,t=1,D=10,glass=N-BK7,axis=0:0:1",
+        "--ray", Y);
     BAD("d", "zero direction", "--lens", L, "--ray", "o=0,0,-10 d=0,0,0");
     BAD(NULL, "impossible lens D=60 R1=25.8", "--lens",
         "R1=25.8,R2=inf,t=5.3,D=60,glass=N-BK7", "--ray", Y);
@@ -1139,6 +1147,58 @@ static void test_errors(void)
         "o=0,0,-10 d=nan,0,1", "--backward");
 }
 
+/* A uniaxial crystal: an a-cut plate (axis 1:1:0 in its faces) at normal
+ * incidence splits x light into an o ray (op n_o t) and an e ray (op n_e
+ * t, "waves":1), each carrying half of T = (1 - R)^2 at depth 2 (op is
+ * relative to air, as the indices). */
+static void test_crystal(void)
+{
+    static output o;
+    const double no = 1.6584, ne = 1.4864, t = 0.03;
+    proc p = run("--lens", "R1=0,R2=0,t=0.03,D=10,no=1.6584,ne=1.4864,axis=1:1:0", "--ray",
+                 "o=0,0,-1 d=0,0,1 lambda=587.7247 vp=1,0,0", "--depth", "2",
+                 (const char *)NULL);
+    expect_success(&p, "crystal");
+    parse_output(&p, &o, "crystal");
+    check_balance(&o, "crystal");
+    int seen_o = 0, seen_e = 0;
+    for (size_t i = 0; i < o.n; i++) {
+        const rayline *r = &o.rays[i];
+        if (r->depth != 2)
+            continue;
+        double w = 0;
+        int e = jnum(r->text, "waves", &w) && w == 1;
+        double n = e ? ne : no, R = fresnel_normal(1.0, n);
+        CHECK_REL(r->op, n * t, 1e-12, "crystal: %c ray op", e ? 'e' : 'o');
+        CHECK_REL(r->I, 0.5 * (1 - R) * (1 - R), 1e-12, "crystal: %c ray I", e ? 'e' : 'o');
+        seen_e += e;
+        seen_o += !e;
+    }
+    CHECK(seen_o == 1 && seen_e == 1, "crystal: one o and one e ray (%d, %d)", seen_o, seen_e);
+    free(o.buf);
+    proc_free(&p);
+    p = run("--lens", "R1=0,R2=0,t=0.03,D=10,crystal=calcite", "--ray",
+            "o=0,0,-1 d=0,0,1 lambda=589", (const char *)NULL);
+    expect_success(&p, "built-in crystal");
+    proc_free(&p);
+    /* backward: the same o and e rays reach the eye */
+    p = run("--lens", "R1=0,R2=0,t=0.03,D=10,no=1.6584,ne=1.4864,axis=1:1:0", "--ray",
+            "o=0,0,-1 d=0,0,1 lambda=587.7247 vp=1,0,0", "--depth", "2", "--backward",
+            (const char *)NULL);
+    expect_success(&p, "crystal backward");
+    parse_output(&p, &o, "crystal backward");
+    check_balance(&o, "crystal backward");
+    double sum2 = 0;
+    for (size_t i = 0; i < o.n; i++)
+        if (o.rays[i].depth == 2)
+            sum2 += o.rays[i].I;
+    double Ro = fresnel_normal(1.0, no), Re = fresnel_normal(1.0, ne);
+    CHECK_REL(sum2, 0.5 * ((1 - Ro) * (1 - Ro) + (1 - Re) * (1 - Re)), 1e-12,
+              "crystal backward: depth-2 power");
+    free(o.buf);
+    proc_free(&p);
+}
+
 int main(void)
 {
     double i2;
@@ -1158,5 +1218,6 @@ int main(void)
     test_errors();
     test_wavelength_convention();
     test_rays_file();
+    test_crystal();
     return check_finish("test_lenstrace_cli");
 }
