@@ -782,7 +782,14 @@ void rs__fetch(parser *p)
             return;
         }
         if (t.kind == RS_TOK_DIRECTIVE) {
+            if (p->fetch_depth >= RS_MAX_DEPTH) {
+                rs__error_at(p, t.line, t.column,
+                             "directives inside directives nested deeper than %d", RS_MAX_DEPTH);
+                continue;
+            }
+            p->fetch_depth++;
             directive(p, &t);
+            p->fetch_depth--;
             if (p->n_la > 0 && !p->failed)
                 return;
             continue;
@@ -790,7 +797,15 @@ void rs__fetch(parser *p)
         if (t.kind == RS_TOK_IDENT) {
             const macro *m = rs__macro_find(p, t.text, t.len);
             if (m != NULL && rs__sym_find(p, t.text, t.len) == NULL) {
+                if (p->fetch_depth >= RS_MAX_DEPTH) {
+                    rs__error_at(p, t.line, t.column,
+                                 "macro calls inside arguments nested deeper than %d",
+                                 RS_MAX_DEPTH);
+                    continue;
+                }
+                p->fetch_depth++;
                 call_macro(p, &t, m);
+                p->fetch_depth--;
                 continue;
             }
         }

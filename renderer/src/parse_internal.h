@@ -134,6 +134,8 @@ typedef struct parser {
     char **buffers;         /* file texts read (macros point into them) */
     size_t n_buffers;
     int allow_inf;          /* `inf` is a value (lens radii) */
+    int fetch_depth;        /* rs__fetch calls in progress (a directive's
+                               arguments may hold directives) */
     int in_vector;          /* reading a vector literal's components */
     int depth;
     char *msg;
