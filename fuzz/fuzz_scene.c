@@ -6,7 +6,10 @@
  * primary rays are intersected with the scene.  What the parser stores must
  * be finite, with unit normals and positive sizes (parser.h); any
  * crash, sanitizer report, leak, hang or runaway allocation is a bug; a
- * refusal must come with a "<fuzz>:LINE:COL: ..." message. */
+ * refusal must come with a "<fuzz>:LINE:COL: ..." message.  #include is
+ * off (no file is read), and a parse reads at most 10^5 tokens and makes
+ * at most 2000 objects, so that endless #while loops and macro calls end
+ * in milliseconds. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -83,7 +86,23 @@ static void check_scene(const rs_scene *s)
                     unit(o->u.polarizer.axis) && isfinite(o->u.polarizer.radius) &&
                     o->u.polarizer.radius > 0.0);
             break;
+        case RS_OBJ_CYLINDER:
+            require(fin(o->u.cylinder.base) && fin(o->u.cylinder.cap) &&
+                    isfinite(o->u.cylinder.radius) && o->u.cylinder.radius > 0.0);
+            break;
+        case RS_OBJ_CONE:
+            require(fin(o->u.cone.base) && fin(o->u.cone.cap) &&
+                    isfinite(o->u.cone.base_radius) && isfinite(o->u.cone.cap_radius) &&
+                    o->u.cone.base_radius >= 0.0 && o->u.cone.cap_radius >= 0.0);
+            break;
+        case RS_OBJ_TORUS:
+            require(isfinite(o->u.torus.major) && isfinite(o->u.torus.minor) &&
+                    o->u.torus.major > 0.0 && o->u.torus.minor > 0.0);
+            break;
         }
+        require(isfinite(o->finish.phong) && isfinite(o->finish.phong_size) &&
+                o->finish.phong_size > 0.0 && isfinite(o->finish.roughness) &&
+                o->finish.roughness > 0.0 && isfinite(o->ior) && o->ior > 0.0);
     }
     for (size_t i = 0; i < s->n_lights; i++) {
         const rs_light *l = &s->lights[i];
@@ -108,6 +127,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     memcpy(text, data, size);
     text[size] = '\0';
     rs_parse_opts_init(&opts);
+    opts.no_include = 1;       /* no file is opened */
+    opts.max_tokens = 100000;  /* loops and macro recursion end fast */
+    opts.max_objects = 2000;
     rs_scene_init(&scene);
     rc = rs_parse_string(text, "<fuzz>", &opts, &scene, msg, sizeof msg);
     if (rc != 0) {

@@ -6,7 +6,7 @@
 set -eu
 cd "$(dirname "$0")/.."
 
-PACKAGES="gcc make cmake libc6-dev pkg-config libpng-dev zlib1g-dev povray"
+PACKAGES="gcc make cmake libc6-dev pkg-config libpng-dev zlib1g-dev povray povray-includes"
 
 missing=""
 for p in $PACKAGES; do

@@ -17,6 +17,7 @@
 
 #include "experiments.h"
 #include "plot.h"
+#include "library_path.h"
 #include "parser.h"
 #include "scene.h"
 
@@ -153,7 +154,12 @@ static int load_lenses(ex_ctx *ctx, const char *dir)
         rs_scene_init(&scene);
         /* prepare: the lenses get their catalog glass (the parser keeps only
          * the name) */
-        if (rs_parse_file(path, NULL, &scene, msg, sizeof msg) != 0 ||
+        const char *dirs[4];
+        rs_parse_opts po;
+        rs_parse_opts_init(&po);
+        po.include_dirs = dirs; /* POV-Ray's colors.inc ..., as lensrender */
+        po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
+        if (rs_parse_file(path, &po, &scene, msg, sizeof msg) != 0 ||
             rs_scene_prepare(&scene, msg, sizeof msg) != 0) {
             snprintf(ctx->msg, sizeof ctx->msg, "%s", msg);
             rc = -1;

@@ -26,6 +26,7 @@
 #include "support/cli.h"
 #include "support/image.h"
 #include "integrator.h"
+#include "library_path.h"
 #include "montage.h"
 #include "parser.h"
 #include "povray.h"
@@ -501,6 +502,7 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
     char msg[MSG_MAX] = "", path[PATH_MAX], lens_inc[PATH_MAX], log_path[PATH_MAX];
     run_state st;
     rs_parse_opts popts;
+    const char *dirs[4];
     rs_view view;
     pc_report *rep = &sum->rep;
     int status = 0, w = o->width, h = o->height;
@@ -513,6 +515,8 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
     rs_parse_opts_init(&popts);
     popts.image_width = w;
     popts.image_height = h;
+    popts.include_dirs = dirs;
+    popts.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
 
 #define FAIL(code, ...)                                                                        \
     do {                                                                                       \

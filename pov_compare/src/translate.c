@@ -2,10 +2,12 @@
  *
  * The rules follow POV-Ray 3.7's measured behaviour:
  *   - `#version 3.7;` first, assumed_gamma 1, adc_bailout 0 (depth alone
- *     decides); every finish written out in full (ambient, diffuse,
- *     emission as the scene holds them, specular and phong 0), since
- *     POV-Ray's defaults are not what a user of our language might expect
- *     to be written;
+ *     decides); every finish written out in full as the scene holds it
+ *     (ambient, diffuse, brilliance, emission, phong, phong_size, specular,
+ *     roughness, reflection with its fresnel flag, and the object's ior
+ *     when fresnel needs it), so that no default of either program
+ *     decides anything; what the scene reader warned about (read but not
+ *     rendered) becomes a note;
  *   - lenses as CSG from lens.inc, the interior on the CSG parent, clear
  *     glass `rgbf 1` with exact Fresnel reflection and conserve_energy;
  *   - no object may contain the camera: a plane, sphere or box whose
@@ -308,6 +310,21 @@ static int pov_inside(const rs_object *o, lp_vec3 world)
         lp_vec3 a = o->u.box.corner1, b = o->u.box.corner2;
         return p.x > a.x && p.x < b.x && p.y > a.y && p.y < b.y && p.z > a.z && p.z < b.z;
     }
+    case RS_OBJ_CYLINDER:
+    case RS_OBJ_CONE: {
+        int cyl = o->type == RS_OBJ_CYLINDER;
+        lp_vec3 b = cyl ? o->u.cylinder.base : o->u.cone.base;
+        lp_vec3 ax = v3_sub(cyl ? o->u.cylinder.cap : o->u.cone.cap, b), w = v3_sub(p, b);
+        double h2 = v3_dot(ax, ax), s = v3_dot(w, ax) / h2;
+        double r1 = cyl ? o->u.cylinder.radius : o->u.cone.base_radius;
+        double r2 = cyl ? o->u.cylinder.radius : o->u.cone.cap_radius, r = r1 + (r2 - r1) * s;
+        lp_vec3 q = v3_sub(w, v3_scale(ax, s));
+        return s > 0.0 && s < 1.0 && v3_dot(q, q) < r * r;
+    }
+    case RS_OBJ_TORUS: {
+        double rho = sqrt(p.x * p.x + p.z * p.z) - o->u.torus.major;
+        return rho * rho + p.y * p.y < o->u.torus.minor * o->u.torus.minor;
+    }
     default:
         return -1;
     }
@@ -327,6 +344,9 @@ static const char *type_name(rs_object_type t)
     case RS_OBJ_DISC: return "disc";
     case RS_OBJ_LENS: return "lens";
     case RS_OBJ_POLARIZER: return "polarizer";
+    case RS_OBJ_CYLINDER: return "cylinder";
+    case RS_OBJ_CONE: return "cone";
+    case RS_OBJ_TORUS: return "torus";
     }
     return "object";
 }
@@ -446,9 +466,23 @@ static void put_finish(FILE *out, const rs_finish *f)
     put_rgb(out, f->ambient);
     fputs(" diffuse ", out);
     put_num(out, f->diffuse);
+    fputs(" brilliance ", out);
+    put_num(out, f->brilliance);
     fputs(" emission ", out);
     put_rgb(out, f->emission);
-    fputs(" specular 0 phong 0 }\n", out);
+    fputs("\n    phong ", out);
+    put_num(out, f->phong);
+    fputs(" phong_size ", out);
+    put_num(out, f->phong_size);
+    fputs(" specular ", out);
+    put_num(out, f->specular);
+    fputs(" roughness ", out);
+    put_num(out, f->roughness);
+    fputs("\n    reflection { ", out);
+    put_rgb(out, f->fresnel ? f->reflection_min : f->reflection_max);
+    fputs(", ", out);
+    put_rgb(out, f->reflection_max);
+    fputs(f->fresnel ? " fresnel on } }\n" : " } }\n", out);
 }
 
 static int check_object(const rs_object *o)
@@ -456,7 +490,11 @@ static int check_object(const rs_object *o)
     if (!xf_finite(&o->xf) || !color_finite(o->pigment.color[0]) ||
         !color_finite(o->pigment.color[1]) || !xf_finite(&o->pigment.to_pattern) ||
         !color_finite(o->finish.ambient) || !color_finite(o->finish.emission) ||
-        !isfinite(o->finish.diffuse))
+        !isfinite(o->finish.diffuse) || !isfinite(o->finish.brilliance) ||
+        !isfinite(o->finish.phong) || !isfinite(o->finish.phong_size) ||
+        !isfinite(o->finish.specular) || !isfinite(o->finish.roughness) ||
+        !color_finite(o->finish.reflection_min) || !color_finite(o->finish.reflection_max) ||
+        !isfinite(o->ior))
         return -1;
     switch (o->type) {
     case RS_OBJ_PLANE:
@@ -525,11 +563,40 @@ static void put_shape(FILE *out, const rs_object *o, int turn, double k)
         }
         fputs("\n", out);
         break;
+    case RS_OBJ_CYLINDER:
+    case RS_OBJ_CONE: {
+        int cone = o->type == RS_OBJ_CONE;
+        fputs(cone ? "cone { " : "cylinder { ", out);
+        put_vec(out, cone ? o->u.cone.base : o->u.cylinder.base);
+        if (cone) {
+            fputs(", ", out);
+            put_num(out, o->u.cone.base_radius);
+        }
+        fputs(", ", out);
+        put_vec(out, cone ? o->u.cone.cap : o->u.cylinder.cap);
+        fputs(", ", out);
+        put_num(out, cone ? o->u.cone.cap_radius : o->u.cylinder.radius);
+        fputs((cone ? o->u.cone.open : o->u.cylinder.open) ? " open" : "", out);
+        fputs(turn ? " inverse\n" : "\n", out);
+        break;
+    }
+    case RS_OBJ_TORUS:
+        fputs("torus { ", out);
+        put_num(out, o->u.torus.major);
+        fputs(", ", out);
+        put_num(out, o->u.torus.minor);
+        fputs(turn ? " inverse\n" : "\n", out);
+        break;
     default:
         return;
     }
     put_pigment(out, o);
     put_finish(out, &o->finish);
+    if (o->finish.fresnel) {
+        fputs("  interior { ior ", out);
+        put_num(out, o->ior);
+        fputs(" }\n", out);
+    }
     if (k != 1.0 || !xf_is_identity(&o->xf)) {
         fputs("  ", out);
         put_matrix(out, &o->xf, k);
@@ -598,14 +665,16 @@ static void put_camera(FILE *out, const rs_camera *c, double k)
     /* POV-Ray applies these in its own fixed order (up, right, angle,
      * look_at, then the transforms), as our camera does; the order written
      * here is that order too. */
-    fputs("camera {\n  perspective\n  location ", out);
+    fputs(c->orthographic ? "camera {\n  orthographic\n  location "
+                          : "camera {\n  perspective\n  location ", out);
     put_vec(out, v3_scale(c->location, k));
     fputs("\n  direction ", out);
     put_vec(out, c->direction);
+    /* an orthographic camera's right and up are lengths of the scene */
     fputs("\n  right ", out);
-    put_vec(out, c->right);
+    put_vec(out, c->orthographic ? v3_scale(c->right, k) : c->right);
     fputs("\n  up ", out);
-    put_vec(out, c->up);
+    put_vec(out, c->orthographic ? v3_scale(c->up, k) : c->up);
     fputs("\n  sky ", out);
     put_vec(out, c->sky);
     fputs("\n", out);
@@ -686,6 +755,15 @@ static int add_feature_notes(const rs_scene *sc, pc_notes *notes)
         (blackbody && pc_notes_add(notes, PC_NOTE_BLACKBODY_LIGHTS) != 0) ||
         (lpol && pc_notes_add(notes, PC_NOTE_LIGHT_POLARIZATION) != 0))
         return -1;
+    for (size_t i = 0; i < sc->n_messages; i++) {
+        char text[600];
+        if (sc->messages[i].kind != RS_MSG_WARNING)
+            continue;
+        snprintf(text, sizeof text, "the scene reader warned (not rendered by lensrender, "
+                 "left out of the POV-Ray scene): %s", sc->messages[i].text);
+        if (pc_notes_add(notes, text) != 0)
+            return -1;
+    }
     return 0;
 }
 

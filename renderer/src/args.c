@@ -37,6 +37,8 @@ void rs_args_init(rs_args *args)
     args->wavelengths = 16;
     args->threads = 0;
     args->cutoff = -1.0;
+    args->aa = 1;
+    args->aa_threshold = -1.0;
 }
 
 const char *rs_mode_name(rs_mode mode)
@@ -105,7 +107,7 @@ static const char *int_option(rs_args *args, const char *name, const char *val,
 /* The options that take a value. */
 enum {
     OPT_OUT, OPT_WIDTH, OPT_HEIGHT, OPT_MODE, OPT_DEPTH, OPT_WAVELENGTHS,
-    OPT_THREADS, OPT_PFM, OPT_CUTOFF, OPT_TOLERANCE, OPT_COUNT
+    OPT_THREADS, OPT_PFM, OPT_CUTOFF, OPT_AA, OPT_LIBRARY, OPT_TOLERANCE, OPT_COUNT
 };
 
 static const struct {
@@ -122,6 +124,9 @@ static const struct {
     { "--threads", OPT_THREADS },
     { "--pfm", OPT_PFM },
     { "--cutoff", OPT_CUTOFF },
+    { "--aa", OPT_AA },
+    { "--library", OPT_LIBRARY },
+    { "-L", OPT_LIBRARY },
     { "--tolerance", OPT_TOLERANCE },
 };
 
@@ -166,6 +171,16 @@ static const char *set_value(rs_args *args, int id, const char *name,
         else
             return fail(args, "%s: unknown mode '%s' (rgb, schlick, fresnel, "
                         "polarized or auto)", name, val);
+        return NULL;
+    case OPT_AA:
+        return int_option(args, name, val, 1, RS_ARGS_AA_MAX, &args->aa);
+    case OPT_LIBRARY:
+        if (*val == '\0')
+            return fail(args, "%s: empty directory name", name);
+        if (args->n_library == RS_ARGS_LIBRARY_MAX)
+            return fail(args, "%s: at most %d library directories", name,
+                        RS_ARGS_LIBRARY_MAX);
+        args->library[args->n_library++] = val;
         return NULL;
     case OPT_CUTOFF: {
         double v;
@@ -213,6 +228,52 @@ static const char *derive_output(rs_args *args)
     return NULL;
 }
 
+/* POV-Ray's +W640 +H480 +Oout.png +A[threshold] -A +LDIR.  1: it was one
+ * (args->error set on a bad value), 0: not one of them. */
+static int pov_option(rs_args *args, const char *a, const char **err)
+{
+    char name[4] = { a[0], a[1], '\0', '\0' };
+    const char *val = a + 2;
+    *err = NULL;
+    if ((a[0] != '+' && a[0] != '-') || a[1] == '\0')
+        return 0;
+    if (a[0] == '-' && (a[1] == 'A' || a[1] == 'a') && a[2] == '\0') {
+        args->aa = 1;
+        args->aa_threshold = -1.0;
+        return 1;
+    }
+    if (a[0] != '+')
+        return 0;
+    switch (a[1]) {
+    case 'W': case 'w':
+        *err = int_option(args, name, val, 1, RS_ARGS_SIZE_MAX, &args->width);
+        return 1;
+    case 'H': case 'h':
+        *err = int_option(args, name, val, 1, RS_ARGS_SIZE_MAX, &args->height);
+        return 1;
+    case 'O': case 'o':
+        *err = set_value(args, OPT_OUT, name, val);
+        return 1;
+    case 'L': case 'l':
+        *err = set_value(args, OPT_LIBRARY, name, val);
+        return 1;
+    case 'A': case 'a':
+        if (*val != '\0') {
+            double t;
+            if (!parse_double(val, &t) || t < 0.0 || t > 3.0) {
+                *err = fail(args, "+A: '%s' is not a threshold (0..3)", val);
+                return 1;
+            }
+            args->aa_threshold = t;
+        }
+        if (args->aa < 2)
+            args->aa = 3;
+        return 1;
+    default:
+        return 0;
+    }
+}
+
 const char *rs_args_parse(rs_args *args, int argc, char **argv)
 {
     int options_done = 0;
@@ -238,6 +299,14 @@ const char *rs_args_parse(rs_args *args, int argc, char **argv)
         int id = -1;
         size_t len;
 
+        if (!options_done) {
+            const char *err;
+            if (pov_option(args, a, &err)) {
+                if (err)
+                    return err;
+                continue;
+            }
+        }
         if (options_done || a[0] != '-' || a[1] == '\0') {
             if (args->scene)
                 return fail(args, "more than one scene file ('%s' and '%s')",

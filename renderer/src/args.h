@@ -4,7 +4,8 @@
  *   lensrender SCENE [-o OUT.png] [--width W] [--height H]
  *              [--mode rgb|schlick|fresnel|polarized|auto] [--depth N]
  *              [--wavelengths N] [--threads N] [--pfm OUT.pfm] [--quiet]
- *              [--cutoff F] [--tolerance E]
+ *              [--cutoff F] [--tolerance E] [--aa N] [-L DIR]...
+ *   and POV-Ray's habits: +WW +HH +OOUT.png +A[THRESHOLD] -A +LDIR
  *   lensrender --help | --version
  *
  * Parsing only: nothing here prints, exits, allocates or touches global
@@ -30,6 +31,8 @@
 #define RS_ARGS_DEPTH_MAX 256                      /* POV-Ray's max_trace_level */
 #define RS_ARGS_WAVELENGTHS_MAX 1024
 #define RS_ARGS_THREADS_MAX 1024
+#define RS_ARGS_AA_MAX 16                          /* --aa: N x N per pixel */
+#define RS_ARGS_LIBRARY_MAX 32                     /* -L directories */
 
 typedef struct rs_args {
     int help;             /* --help / -h: print usage; nothing else parsed */
@@ -54,6 +57,12 @@ typedef struct rs_args {
     int no_dispersion;    /* --no-dispersion: every glass becomes a constant,
                              lossless index, its index at 587.56 nm (for
                              comparisons with POV-Ray) */
+    int aa;               /* --aa N: N x N regular samples per pixel, 1..16
+                             (default 1); +A alone: 3; -A: 1 */
+    double aa_threshold;  /* +A0.3: read; < 0 when not given (supersampling
+                             is regular, the threshold is not used) */
+    const char *library[RS_ARGS_LIBRARY_MAX]; /* -L DIR / +LDIR, in order */
+    int n_library;
     char out_default[RS_ARGS_PATH_MAX];
     char error[RS_ARGS_ERROR_MAX];
 } rs_args;
@@ -62,7 +71,8 @@ typedef struct rs_args {
 void rs_args_init(rs_args *args);
 
 /* Parse argv[1..argc).  Accepts "--opt VALUE" and "--opt=VALUE" (and
- * "-o VALUE"); "--" ends the options.  When --help/-h or --version/-V
+ * "-o VALUE", "-L DIR"), and POV-Ray's "+W640", "+H480", "+Oout.png",
+ * "+A", "+A0.3", "-A", "+LDIR" (one argument each); "--" ends the options.  When --help/-h or --version/-V
  * appears, only that flag is set (the first wins) and nothing else is
  * checked or required.  Repeating an option keeps the last value.
  * Returns NULL on success, else args->error. */

@@ -72,6 +72,30 @@ int rs_object_bounds(const rs_object *o, lp_vec3 *lo_out, lp_vec3 *hi_out)
     case RS_OBJ_BOX:
         xf_box(&o->xf, o->u.box.corner1, o->u.box.corner2, lo, hi);
         break;
+    case RS_OBJ_CYLINDER:
+    case RS_OBJ_CONE: { /* the hull of two end discs: inside their cubes */
+        int cyl = o->type == RS_OBJ_CYLINDER;
+        lp_vec3 p0 = cyl ? o->u.cylinder.base : o->u.cone.base;
+        lp_vec3 p1 = cyl ? o->u.cylinder.cap : o->u.cone.cap;
+        double r0 = fabs(cyl ? o->u.cylinder.radius : o->u.cone.base_radius);
+        double r1 = fabs(cyl ? o->u.cylinder.radius : o->u.cone.cap_radius);
+        double l2[3], h2[3];
+        xf_box(&o->xf, (lp_vec3){p0.x - r0, p0.y - r0, p0.z - r0},
+               (lp_vec3){p0.x + r0, p0.y + r0, p0.z + r0}, lo, hi);
+        xf_box(&o->xf, (lp_vec3){p1.x - r1, p1.y - r1, p1.z - r1},
+               (lp_vec3){p1.x + r1, p1.y + r1, p1.z + r1}, l2, h2);
+        for (int k = 0; k < 3; k++) {
+            lo[k] = l2[k] < lo[k] ? l2[k] : lo[k];
+            hi[k] = h2[k] > hi[k] ? h2[k] : hi[k];
+        }
+        break;
+    }
+    case RS_OBJ_TORUS: /* about y: |x|, |z| <= major + minor, |y| <= minor */
+        r = fabs(o->u.torus.major) + fabs(o->u.torus.minor);
+        a = (lp_vec3){-r, -fabs(o->u.torus.minor), -r};
+        b = (lp_vec3){r, fabs(o->u.torus.minor), r};
+        xf_box(&o->xf, a, b, lo, hi);
+        break;
     case RS_OBJ_POLARIZER:
         c = o->u.polarizer.center;
         r = fabs(o->u.polarizer.radius);
@@ -223,6 +247,12 @@ void rs_bvh_destroy(rs_bvh *b)
     free(b->obj);
     free(b->unbounded);
     free(b);
+}
+
+int rs_bvh_serves(const rs_bvh *b, const rs_scene *scene)
+{
+    return b && b->n_objects == scene->n_objects &&
+           b->n_objects - b->n_unbounded >= RS_BVH_MIN_BOUNDED;
 }
 
 size_t rs_bvh_node_count(const rs_bvh *b) { return b ? b->n_nodes : 0; }

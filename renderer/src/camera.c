@@ -192,6 +192,7 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
             return -1;
     }
 
+    v.orthographic = cam->orthographic;
     /* 5. focal blur. */
     v.lens_radius = 0.0;
     v.focal_distance = 0.0;
@@ -203,6 +204,9 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
                     cam->aperture);
     if (cam->blur_samples < 0)
         return fail(msg, msg_size, "camera: blur_samples %d is negative", cam->blur_samples);
+    if (cam->aperture > 0.0 && cam->orthographic)
+        return fail(msg, msg_size, "camera: focal blur (aperture) with an orthographic camera "
+                                   "is not supported");
     if (cam->aperture > 0.0) {
         lp_vec3 fp = cam->has_xf ? rs_xf_point(&cam->xf, cam->focal_point) : cam->focal_point;
         lp_vec3 dh = v_unit(v.D), x;
@@ -231,6 +235,11 @@ void rs_camera_ray(const rs_view *v, double px, double py, int width,
 {
     double x0 = px / (double)width - 0.5;
     double y0 = 0.5 - py / (double)height;
+    if (v->orthographic) {
+        *origin = v_add(v_add(v->location, v_scale(v->R, x0)), v_scale(v->U, y0));
+        *dir = v_unit(v->D);
+        return;
+    }
     lp_vec3 d = v_add(v_add(v->D, v_scale(v->R, x0)), v_scale(v->U, y0));
     *origin = v->location;
     *dir = v_unit(d);

@@ -34,6 +34,8 @@
  * column i = 0..W-1 from the left, row j = 0..H-1 from the top, pixel
  * centre px = i + 0.5, py = j + 0.5,
  *   dir = normalize(D + (px/W - 0.5) R + (0.5 - py/H) U), origin = location.
+ * Orthographic (`orthographic`): dir = normalize(D) for every pixel,
+ *   origin = location + (px/W - 0.5) R + (0.5 - py/H) U.
  *
  * Focal blur (POV-Ray's focal_point and aperture): with aperture A > 0 the
  * camera is a thin lens, a disk of radius A/2 about the location,
@@ -63,6 +65,9 @@ typedef struct rs_view {
     lp_vec3 D;   /* direction: from location to the image centre */
     lp_vec3 R;   /* right: spans the image width, left edge to right edge */
     lp_vec3 U;   /* up: spans the image height, bottom edge to top edge */
+    int orthographic; /* rays along D from location + x0 R + y0 U (the
+                         image is |R| by |U| scene units), POV-Ray's
+                         orthographic camera */
     double lens_radius;    /* aperture / 2; 0: a pinhole */
     double focal_distance; /* |focal_point - location| */
     lp_vec3 lens_x, lens_y; /* unit, spanning the lens disk (perpendicular to D) */

@@ -116,6 +116,7 @@ void rs_render_opts_init(rs_render_opts *o)
     o->cutoff = -1.0;
     o->width = 320;
     o->height = 240;
+    o->aa = 1;
 }
 
 /* The linear sRGB colour of a light's spectrum (negative components of
@@ -533,7 +534,7 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
     sg.dist = dist;
     sg.np = 0;
     int blocked = 0;
-    if (sc->bvh && rs_bvh_object_count(sc->bvh) == sc->n_objects)
+    if (rs_bvh_serves(sc->bvh, sc))
         blocked = rs_bvh_any(sc->bvh, x, d, sg.eps, dist, shadow_meets, &sg);
     else
         for (size_t i = 0; i < sc->n_objects && !blocked; i++)
@@ -579,25 +580,51 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
  * calls emit(source, radiance) for each non-zero source. */
 typedef void (*emit_fn)(void *ctx, int source, double radiance);
 
-/* reach, when not NULL, holds light_reach of each light from this hit
- * (NaN where not yet known): the lanes of a packet share their shadow
- * rays through it. */
-static void shade(const rs_integrator *it, const band *b, const rs_hit *h, double *reach,
+/* POV-Ray 3.7's highlights for one light (see rs_finish): phong about the
+ * mirror direction, specular (Blinn) about the half vector; the light's
+ * colour, not the pigment's. */
+static double highlight(const rs_finish *f, lp_vec3 n, lp_vec3 d, lp_vec3 l)
+{
+    double s = 0.0;
+    if (f->phong > 0.0) {
+        lp_vec3 r = madd(d, n, -2.0 * dot(d, n));
+        double c = dot(r, l);
+        if (c > 0.0)
+            s += f->phong * pow(c, f->phong_size);
+    }
+    if (f->specular > 0.0) {
+        lp_vec3 hv = unit((lp_vec3){l.x - d.x, l.y - d.y, l.z - d.z});
+        double c = dot(hv, n);
+        if (c > 0.0)
+            s += f->specular * pow(c, 1.0 / f->roughness);
+    }
+    return s;
+}
+
+/* Light leaving a surface towards the viewer along d, per source: emission,
+ * ambient, and for each visible light diffuse (N.L)^brilliance plus the
+ * highlights.  Calls emit(source, radiance) for each non-zero source.
+ * reach, when not NULL, holds light_reach of each light from this hit (NaN
+ * where not yet known): the lanes of a packet share their shadow rays
+ * through it. */
+static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_vec3 dir,
+                  double *reach,
                   emit_fn emit, void *ctx)
 {
     const rs_scene *sc = it->scene;
     const rs_object *o = &sc->objects[h->object];
+    const rs_finish *f = &o->finish;
     rs_color pig = pigment_at(&o->pigment, h->point);
-    double e = band_emission(b, mul(pig, o->finish.emission));
+    double e = band_emission(b, mul(pig, f->emission));
     if (e != 0.0)
         emit(ctx, src_object(it, h->object), e);
-    double a = band_emission(b, mul(pig, mul(o->finish.ambient, sc->settings.ambient_light)));
+    double a = band_emission(b, mul(pig, mul(f->ambient, sc->settings.ambient_light)));
     if (a != 0.0)
         emit(ctx, 0, a);
-    if (o->finish.diffuse == 0.0 || sc->n_lights == 0)
+    if (sc->n_lights == 0)
         return;
-    double rho = band_reflectance(b, pig) * o->finish.diffuse;
-    if (rho == 0.0)
+    double rho = band_reflectance(b, pig) * f->diffuse;
+    if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
         return;
     lp_vec3 x = madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
     for (size_t k = 0; k < sc->n_lights; k++) {
@@ -605,7 +632,9 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, doubl
         lp_vec3 ld = unit((lp_vec3){l->position.x - x.x, l->position.y - x.y,
                                     l->position.z - x.z});
         double c = dot(ld, h->normal);
-        if (c <= 0.0)
+        double s = highlight(f, h->normal, dir, ld);
+        double diff = c > 0.0 ? rho * (f->brilliance == 1.0 ? c : pow(c, f->brilliance)) : 0.0;
+        if (diff + s <= 0.0)
             continue;
         double p = band_light(it, b, (int)k);
         if (p == 0.0)
@@ -619,8 +648,39 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, doubl
         }
         if (p == 0.0)
             continue;
-        emit(ctx, src_light(it, (int)k), rho * c * p);
+        emit(ctx, src_light(it, (int)k), (diff + s) * p);
     }
+}
+
+/* The mirror reflectivity of a surface in this band for a ray along d
+ * (0: none): `reflection` as min + (max - min) F, F the unpolarized Fresnel
+ * reflectance into the object's ior with fresnel on, else max. */
+static double reflectivity(const band *b, const rs_object *o, const rs_hit *h, lp_vec3 d)
+{
+    const rs_finish *f = &o->finish;
+    double rmax = band_reflectance(b, f->reflection_max);
+    if (!f->fresnel)
+        return rmax;
+    double rmin = band_reflectance(b, f->reflection_min);
+    double ci = -dot(d, h->normal), n = o->ior;
+    double F = 0.0;
+    if (ci > 1.0)
+        ci = 1.0;
+    double st2 = (1.0 - ci * ci) / (n * n);
+    if (st2 >= 1.0) {
+        F = 1.0;
+    } else if (n != 1.0) {
+        double ct = sqrt(1.0 - st2);
+        double rs = (ci - n * ct) / (ci + n * ct), rp = (n * ci - ct) / (n * ci + ct);
+        F = 0.5 * (rs * rs + rp * rp);
+    }
+    return rmin + (rmax - rmin) * F;
+}
+
+static int has_reflection(const rs_finish *f)
+{
+    const rs_color a = f->reflection_min, c = f->reflection_max;
+    return a.r > 0.0 || a.g > 0.0 || a.b > 0.0 || c.r > 0.0 || c.g > 0.0 || c.b > 0.0;
 }
 
 /* ---- the unpolarized modes: one number per ray ---- */
@@ -703,7 +763,43 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
         for (size_t k = 0; k < sc->n_lights; k++)
             fr->reach[k] = NAN;
     for (int k = 0; k < n; k++)
-        shade(it, &it->lanes[lane[k]], &h, fr ? fr->reach : NULL, emit_sum, &out[k]);
+        shade(it, &it->lanes[lane[k]], &h, d, fr ? fr->reach : NULL, emit_sum, &out[k]);
+    if (!has_reflection(&ob->finish) || level >= it->max_level || f + 1 >= RS_MAX_FRAMES)
+        return;
+    lp_vec3 rd = unit(madd(d, h.normal, -2.0 * dot(d, h.normal)));
+    lp_vec3 x = madd(h.point, h.normal, 1e-9 * (1.0 + sqrt(dot(h.point, h.point))));
+    if (!fr) { /* no memory for the split: one lane at a time */
+        for (int k = 0; k < n; k++) {
+            double r = reflectivity(&it->lanes[lane[k]], ob, &h, d), v;
+            if (r > 0.0 && weight * r >= it->cutoff) {
+                trace_scalar(w, &lane[k], 1, x, rd, level + 1, weight * r, -1, f + 1, &v);
+                out[k] += r * v;
+            }
+        }
+        return;
+    }
+    /* The mirror ray, shared by the lanes of equal reflectivity (they
+     * carry the same weight on). */
+    for (int k = 0; k < n; k++) {
+        double r = reflectivity(&it->lanes[lane[k]], ob, &h, d);
+        fr->val[k] = r;
+        fr->done[k] = !(r > 0.0 && weight * r >= it->cutoff);
+    }
+    for (int k = 0; k < n; k++) {
+        if (fr->done[k])
+            continue;
+        double r = fr->val[k];
+        int m = 0;
+        for (int j = k; j < n; j++)
+            if (!fr->done[j] && fr->val[j] == r) {
+                fr->done[j] = 1;
+                fr->pos[m] = j;
+                fr->lane[m++] = lane[j];
+            }
+        trace_scalar(w, fr->lane, m, x, rd, level + 1, weight * r, -1, f + 1, fr->acc);
+        for (int j = 0; j < m; j++)
+            out[fr->pos[j]] += r * fr->acc[j];
+    }
 }
 
 /* ---- the polarized mode: bundles ---- */
@@ -745,6 +841,36 @@ static long record_wavelet(rs_worker *w, lp_vec3 o, lp_vec3 d, const rs_hit *h)
 {
     rs_wavelet wl = {o, d, h ? h->point : o, h != NULL, h ? h->object : -1};
     return rs_wavelets_push(&w->wavelets, &wl);
+}
+
+static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
+                      int skip, int f, bundle *out);
+
+/* A mirror reflection in the polarized mode: the bundle seen along the
+ * mirror direction, scaled by the reflectivity, each field mirrored
+ * (Householder) with a pi jump (an ideal conductor reverses the tangential
+ * field), its optical path referred to the origin of the ray along d. */
+static void mirror_pol(rs_worker *w, const band *b, const rs_object *ob, const rs_hit *h,
+                       lp_vec3 d, int level, double weight, int f, frame *fr, bundle *out)
+{
+    double r = reflectivity(b, ob, h, d);
+    if (!(r > 0.0) || weight * r < w->it->cutoff)
+        return;
+    lp_vec3 n = h->normal;
+    lp_vec3 rd = unit(madd(d, n, -2.0 * dot(d, n)));
+    lp_vec3 x = madd(h->point, n, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
+    fr->child.n = 0;
+    trace_pol(w, b, x, rd, level + 1, weight * r, -1, f + 1, &fr->child);
+    for (size_t i = 0; i < fr->child.n; i++) {
+        lp_ray *p = bundle_push(out);
+        if (!p)
+            return;
+        *p = fr->child.r[i];
+        p->intensity *= r;
+        p->vp = madd(p->vp, n, -2.0 * dot(p->vp, n));
+        p->kphi += 1;
+        p->op += h->t;
+    }
 }
 
 static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
@@ -831,7 +957,9 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
     }
     emit_ctx e = {out, d, record_wavelet(w, o, d, &h)};
     if (e.wavelet >= 0)
-        shade(it, b, &h, NULL, emit_halves, &e);
+        shade(it, b, &h, d, NULL, emit_halves, &e);
+    if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES)
+        mirror_pol(w, b, ob, &h, d, level, weight, f, fr, out);
 }
 
 /* The polarized mode's power seen along a camera ray in one band. */
@@ -890,17 +1018,23 @@ static void ray_colour(const rs_integrator *it, rs_worker *w, lp_vec3 o, lp_vec3
 
 void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs_color *out)
 {
+    int aa = it->opts.aa > 1 ? it->opts.aa : 1;
     int n = it->view.samples > 0 ? it->view.samples : 1;
     rs_color sum = {0, 0, 0};
-    for (int k = 0; k < n; k++) {
-        lp_vec3 o, d;
-        rs_color c;
-        rs_camera_aperture_ray(&it->view, i + 0.5, j + 0.5, it->opts.width, it->opts.height, k,
-                               &o, &d);
-        ray_colour(it, w, o, d, &c);
-        sum.r += c.r;
-        sum.g += c.g;
-        sum.b += c.b;
+    /* aa x aa points of the pixel (antialiasing), each with the camera's n
+     * aperture rays */
+    for (int q = 0; q < aa * aa; q++) {
+        double px = i + (q % aa + 0.5) / aa, py = j + (q / aa + 0.5) / aa;
+        for (int k = 0; k < n; k++) {
+            lp_vec3 o, d;
+            rs_color c;
+            rs_camera_aperture_ray(&it->view, px, py, it->opts.width, it->opts.height, k, &o,
+                                   &d);
+            ray_colour(it, w, o, d, &c);
+            sum.r += c.r;
+            sum.g += c.g;
+            sum.b += c.b;
+        }
     }
-    *out = (rs_color){sum.r / n, sum.g / n, sum.b / n};
+    *out = (rs_color){sum.r / (n * aa * aa), sum.g / (n * aa * aa), sum.b / (n * aa * aa)};
 }

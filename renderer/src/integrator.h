@@ -29,6 +29,8 @@ typedef struct rs_render_opts {
     double cutoff;     /* drop branches whose weight bound is below this;
                           < 0: the scene's adc_bailout */
     int width, height;
+    int aa;            /* N x N regular samples per pixel at the centres
+                          of an N x N grid, averaged (default 1) */
 } rs_render_opts;
 
 void rs_render_opts_init(rs_render_opts *o);
@@ -46,9 +48,10 @@ rs_worker *rs_worker_create(const rs_integrator *it);
 void rs_worker_destroy(rs_worker *w);
 
 /* Linear sRGB of pixel (i, j), i = column from the left, j = row from the
- * top: what its camera ray brings, or with a camera aperture the mean of
- * its aperture rays (camera.h).  Deterministic for a given scene, options
- * and pixel. */
+ * top: the mean of its aa x aa points (antialiasing), each what its camera
+ * ray brings, or with a camera aperture the mean of its aperture rays
+ * (camera.h).  Deterministic for a given scene, options and pixel (no
+ * random numbers, whatever thread renders it). */
 void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j,
                          rs_color *out);
 

@@ -200,6 +200,8 @@ void rs_lexer_next(rs_lexer *lx, rs_token *tok)
     if (c == '#') {
         size_t start;
         advance(lx);
+        while (cur(lx) == ' ' || cur(lx) == '\t') /* POV-Ray: "#   debug" */
+            advance(lx);
         if (!is_alpha(cur(lx))) {
             fail(lx, tok, tok->line, tok->column,
                  "expected a directive name after '#'%s", "");

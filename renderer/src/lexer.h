@@ -11,8 +11,8 @@
  *   IDENT      [A-Za-z_][A-Za-z0-9_]*  (case-sensitive)
  *   STRING     "..." on one line; \" \\ \n \t escapes; text/len are the
  *              raw bytes between the quotes (decode with rs_string_decode)
- *   DIRECTIVE  # immediately followed by a name (#declare, #version, ...);
- *              text/len are the name without '#'
+ *   DIRECTIVE  # followed by a name, spaces and tabs between allowed
+ *              (#declare, #   debug, ...); text/len are the name alone
  *   PUNCT      one of  < > { } ( ) [ ] , ; = + - * / . ? : ! & |
  *
  * The lexer works on a caller-owned buffer of known length (embedded NUL

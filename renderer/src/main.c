@@ -17,6 +17,7 @@
 #include "support/cli.h"
 #include "support/image.h"
 #include "integrator.h"
+#include "library_path.h"
 #include "parser.h"
 #include "scene.h"
 #include "support/tiles.h"
@@ -30,7 +31,8 @@ static const char *const usage_text[] = {
 "usage: lensrender SCENE [-o OUT.png] [--width W] [--height H]\n"
 "                  [--mode rgb|schlick|fresnel|polarized|auto] [--depth N]\n"
 "                  [--wavelengths N] [--threads N] [--pfm OUT.pfm] [--quiet]\n"
-"                  [--cutoff F] [--tolerance E]\n"
+"                  [--cutoff F] [--tolerance E] [--aa N] [-L DIR]...\n"
+"       lensrender SCENE +W640 +H480 +Oout.png [+A[THRESHOLD] | -A] [+LDIR]\n"
 "       lensrender --help | --version\n"
 "\n",
 "Renders SCENE, a POV-Ray-style .scene file with lenses, to an 8-bit sRGB\n"
@@ -66,6 +68,13 @@ static const char *const usage_text[] = {
 "                      (default: the scene's adc_bailout, 1/255 if none)\n"
 "  --threads N         worker threads, 1..1024 (default 0: every core)\n"
 "  --pfm FILE          also write linear float RGB (Portable FloatMap)\n"
+"  --aa N              antialiasing: N x N regular samples per pixel,\n"
+"                      1..16 (default 1; +A: 3, -A: 1; a +A threshold is\n"
+"                      read, every pixel is supersampled)\n"
+"  -L, --library DIR   look for #include files in DIR (after the\n"
+"                      including file's directory; repeatable), then in\n"
+"                      " RS_POVRAY_INCLUDE_DIR " and the\n"
+"                      project's share directory when they exist\n"
 "  -q, --quiet         print nothing but errors\n"
 "  --no-dispersion     every glass becomes a constant lossless index, its\n"
 "                      index at 587.56 nm in air, the d line (to compare\n"
@@ -119,12 +128,26 @@ static void render_tile(void *user, void *worker, int x0, int y0, int x1,
         }
 }
 
+/* The reader's warnings and #debug text, on stderr. */
+static void print_messages(const rs_scene *s, int quiet)
+{
+    if (quiet)
+        return;
+    for (size_t i = 0; i < s->n_messages; i++) {
+        if (s->messages[i].kind == RS_MSG_DEBUG)
+            fputs(s->messages[i].text, stderr);
+        else
+            fprintf(stderr, "lensrender: %s\n", s->messages[i].text);
+    }
+}
+
 /* Everything after the command line; returns the exit status. */
 static int run(const rs_args *a)
 {
     char msg[MSG_MAX] = "";
     rs_scene scene;
     rs_parse_opts popts;
+    const char *dirs[RS_ARGS_LIBRARY_MAX + 4];
     rs_view view;
     rs_render_opts ropts;
     rs_integrator *it = NULL;
@@ -139,11 +162,19 @@ static int run(const rs_args *a)
     rs_parse_opts_init(&popts);
     popts.image_width = a->width;
     popts.image_height = a->height;
+    popts.include_dirs = dirs;
+    popts.n_include_dirs = rs_library_path(a->library, (size_t)a->n_library, dirs,
+                                           sizeof dirs / sizeof dirs[0]);
     if (rs_parse_file(a->scene, &popts, &scene, msg, sizeof msg) != 0) {
+        print_messages(&scene, a->quiet);
         say(NULL, msg);
         status = EXIT_BAD;
         goto done;
     }
+    print_messages(&scene, a->quiet);
+    if (a->aa_threshold >= 0.0 && !a->quiet)
+        fprintf(stderr, "lensrender: +A%g: every pixel gets %d x %d regular samples (the "
+                "threshold is not used)\n", a->aa_threshold, a->aa, a->aa);
     if (rs_scene_prepare(&scene, msg, sizeof msg) != 0) {
         say(NULL, msg);
         status = EXIT_BAD;
@@ -168,6 +199,7 @@ static int run(const rs_args *a)
     ropts.cutoff = a->cutoff;
     ropts.width = a->width;
     ropts.height = a->height;
+    ropts.aa = a->aa;
     if (a->mode_auto) {
         char why[512];
         rs_auto_request req = {a->tolerance > 0.0 ? a->tolerance : RS_AUTO_TOLERANCE_DEFAULT,
@@ -182,6 +214,7 @@ static int run(const rs_args *a)
         if (!a->quiet)
             fprintf(stderr, "lensrender: auto: %s\n", why);
     }
+    ropts.aa = a->aa; /* antialiasing is the user's, whatever auto chose */
     depth = ropts.depth > 0 ? ropts.depth : scene.settings.max_trace_level;
     if (rs_integrator_create(&scene, &ropts, &it, msg, sizeof msg) != 0) {
         say(a->scene, msg);

@@ -10,14 +10,13 @@
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "lexer.h"
-#include "parser.h"
+#include "parse_internal.h"
 
-#define MAX_DEPTH 64
 /* An rs_object is about 2.5 kB (a lens description holds two glasses), so
  * 100,000 objects take about 250 MB; a scene asking for more is refused
  * rather than left to exhaust memory.  (The renderer tests every object
@@ -28,96 +27,84 @@
 #define DEFAULT_WIDTH 640
 #define DEFAULT_HEIGHT 480
 #define PI_VALUE 3.14159265358979323846
+#define MAX_STRING 4096
 
 /* ------------------------------------------------------------------ */
-/* Values and the identifier table                                     */
+/* Errors and warnings                                                 */
 /* ------------------------------------------------------------------ */
 
-typedef struct val {
-    int vec;        /* 0: a float in v[0]; 1: a vector */
-    double v[3];
-} val;
+static void vmessage(parser *p, char *buf, size_t size, int line, int column, const char *kind,
+                     const char *fmt, va_list ap)
+{
+    int n = snprintf(buf, size, "%s:%d:%d: %s", p->file, line, column, kind);
+    if (n >= 0 && (size_t)n < size)
+        vsnprintf(buf + n, size - (size_t)n, fmt, ap);
+}
 
-typedef struct sym {
-    char *name;     /* NULL: empty slot */
-    size_t len;
-    val v;
-} sym;
-
-typedef struct parser {
-    rs_lexer lx;
-    rs_token la[2];     /* lookahead */
-    int n_la;
-    rs_scene *scene;
-    const char *file;   /* owned by the scene */
-    double image_width, image_height;
-    size_t max_objects;
-    sym *syms;
-    size_t sym_cap, sym_count;
-    int depth;
-    char *msg;
-    size_t msg_size;
-    int failed;
-} parser;
-
-/* ------------------------------------------------------------------ */
-/* Errors                                                              */
-/* ------------------------------------------------------------------ */
-
-static int error_at(parser *p, int line, int column, const char *fmt, ...)
+int rs__error_at(parser *p, int line, int column, const char *fmt, ...)
 {
     if (!p->failed && p->msg != NULL && p->msg_size > 0) {
         va_list ap;
-        int n = snprintf(p->msg, p->msg_size, "%s:%d:%d: ", p->file, line, column);
-        if (n >= 0 && (size_t)n < p->msg_size) {
-            va_start(ap, fmt);
-            vsnprintf(p->msg + n, p->msg_size - (size_t)n, fmt, ap);
-            va_end(ap);
-        }
+        va_start(ap, fmt);
+        vmessage(p, p->msg, p->msg_size, line, column, "", fmt, ap);
+        va_end(ap);
     }
     p->failed = 1;
     return -1;
 }
 
-/* "expected WHAT, found <token>" at the token (or the lexical error the
- * token stands for). */
-static int expected(parser *p, const rs_token *t, const char *what)
+void rs__warn(parser *p, int line, int column, const char *fmt, ...)
+{
+    char buf[512];
+    va_list ap;
+    if (p->failed)
+        return;
+    va_start(ap, fmt);
+    vmessage(p, buf, sizeof buf, line, column, "warning: ", fmt, ap);
+    va_end(ap);
+    if (rs_scene_add_message(p->scene, RS_MSG_WARNING, buf) != 0)
+        rs__error_at(p, line, column, "out of memory");
+}
+
+#define error_at rs__error_at
+
+/* "expected WHAT, found <token>" at the token (a lexical error was
+ * reported where it was read). */
+int rs__expected(parser *p, const rs_token *t, const char *what)
 {
     char desc[96];
-    if (t->kind == RS_TOK_ERROR)
-        return error_at(p, t->line, t->column, "%s", p->lx.error);
+    if (t->kind == RS_TOK_ERROR || p->failed) {
+        p->failed = 1;
+        return -1;
+    }
     rs_token_describe(t, desc, sizeof desc);
     return error_at(p, t->line, t->column, "expected %s, found %s", what, desc);
 }
+
+#define expected rs__expected
 
 /* ------------------------------------------------------------------ */
 /* Tokens                                                              */
 /* ------------------------------------------------------------------ */
 
-static const rs_token *peek_k(parser *p, int k)
+const rs_token *rs__peek(parser *p)
 {
-    while (p->n_la <= k) {
-        rs_lexer_next(&p->lx, &p->la[p->n_la]);
-        p->n_la++;
-    }
-    return &p->la[k];
-}
-
-static const rs_token *peek(parser *p)
-{
-    return peek_k(p, 0);
+    if (p->n_la == 0)
+        rs__fetch(p);
+    return &p->la;
 }
 
 /* Consume the current token and return a copy of it. */
-static rs_token take(parser *p)
+rs_token rs__take(parser *p)
 {
-    rs_token t = *peek(p);
-    if (t.kind != RS_TOK_EOF && t.kind != RS_TOK_ERROR) {
-        p->la[0] = p->la[1];
-        p->n_la--;
-    }
+    rs_token t = *rs__peek(p);
+    if (t.kind != RS_TOK_EOF && t.kind != RS_TOK_ERROR)
+        p->n_la = 0;
     return t;
 }
+
+#define peek rs__peek
+#define take rs__take
 
 static int is_id(const rs_token *t, const char *kw)
 {
@@ -146,8 +133,8 @@ static void skip_comma(parser *p)
 
 static int enter(parser *p, const rs_token *t)
 {
-    if (++p->depth > MAX_DEPTH)
-        return error_at(p, t->line, t->column, "nesting deeper than %d levels", MAX_DEPTH);
+    if (++p->depth > RS_MAX_DEPTH)
+        return error_at(p, t->line, t->column, "nesting deeper than %d levels", RS_MAX_DEPTH);
     return 0;
 }
 
@@ -198,14 +185,16 @@ static const char *const reserved_words[] = {
     "filter", "transmit", "ambient", "diffuse", "emission", "specular", "phong",
     "phong_size", "brilliance", "roughness", "reflection", "conserve_energy", "metallic",
     "translate", "rotate", "scale", "matrix", "transform", "object", "union",
-    "intersection", "difference", "merge", "interior", "normal", "inf",
+    "intersection", "difference", "merge", "interior", "normal", "inf", "cone", "torus",
+    "open", "inverse", "fresnel", "falloff", "exponent", "crand", "irid",
     /* built-in values */
     "x", "y", "z", "pi", "true", "false", "on", "off", "yes", "no", "image_width",
-    "image_height",
+    "image_height", "version", "clock",
     /* functions */
     "sqrt", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "pow", "abs", "min",
     "max", "radians", "degrees", "exp", "ln", "log", "floor", "ceil", "int", "mod",
-    "vlength", "vnormalize", "vdot", "vcross",
+    "vlength", "vnormalize", "vdot", "vcross", "select", "div", "concat", "str", "chr",
+    "strlen",
 };
 
 static int name_is(const char *text, size_t len, const char *w)
@@ -213,7 +202,7 @@ static int name_is(const char *text, size_t len, const char *w)
     return strlen(w) == len && memcmp(text, w, len) == 0;
 }
 
-static int is_reserved(const char *text, size_t len)
+int rs__is_reserved(const char *text, size_t len)
 {
     for (size_t i = 0; i < sizeof reserved_words / sizeof reserved_words[0]; i++)
         if (name_is(text, len, reserved_words[i]))
@@ -221,87 +210,7 @@ static int is_reserved(const char *text, size_t len)
     return 0;
 }
 
-/* ------------------------------------------------------------------ */
-/* Identifier table (open addressing, FNV-1a)                          */
-/* ------------------------------------------------------------------ */
-
-static size_t hash_name(const char *s, size_t n)
-{
-    size_t h = (size_t)1469598103934665603ull;
-    for (size_t i = 0; i < n; i++) {
-        h ^= (unsigned char)s[i];
-        h *= (size_t)1099511628211ull;
-    }
-    return h;
-}
-
-static sym *sym_find(parser *p, const char *name, size_t len)
-{
-    size_t i;
-    if (p->sym_cap == 0)
-        return NULL;
-    i = hash_name(name, len) & (p->sym_cap - 1);
-    while (p->syms[i].name != NULL) {
-        if (p->syms[i].len == len && memcmp(p->syms[i].name, name, len) == 0)
-            return &p->syms[i];
-        i = (i + 1) & (p->sym_cap - 1);
-    }
-    return NULL;
-}
-
-static int sym_grow(parser *p)
-{
-    size_t cap = p->sym_cap ? p->sym_cap * 2 : 64;
-    sym *s = calloc(cap, sizeof *s);
-    if (s == NULL)
-        return -1;
-    for (size_t k = 0; k < p->sym_cap; k++) {
-        if (p->syms[k].name != NULL) {
-            size_t i = hash_name(p->syms[k].name, p->syms[k].len) & (cap - 1);
-            while (s[i].name != NULL)
-                i = (i + 1) & (cap - 1);
-            s[i] = p->syms[k];
-        }
-    }
-    free(p->syms);
-    p->syms = s;
-    p->sym_cap = cap;
-    return 0;
-}
-
-/* Set name to v (declaring it if new).  -1: out of memory. */
-static int sym_set(parser *p, const char *name, size_t len, const val *v)
-{
-    sym *s = sym_find(p, name, len);
-    size_t i;
-    if (s != NULL) {
-        s->v = *v;
-        return 0;
-    }
-    if ((p->sym_count + 1) * 10 > p->sym_cap * 7 && sym_grow(p) != 0)
-        return -1;
-    i = hash_name(name, len) & (p->sym_cap - 1);
-    while (p->syms[i].name != NULL)
-        i = (i + 1) & (p->sym_cap - 1);
-    p->syms[i].name = malloc(len + 1);
-    if (p->syms[i].name == NULL)
-        return -1;
-    memcpy(p->syms[i].name, name, len);
-    p->syms[i].name[len] = '\0';
-    p->syms[i].len = len;
-    p->syms[i].v = *v;
-    p->sym_count++;
-    return 0;
-}
-
-static void sym_free(parser *p)
-{
-    for (size_t i = 0; i < p->sym_cap; i++)
-        free(p->syms[i].name);
-    free(p->syms);
-    p->syms = NULL;
-    p->sym_cap = p->sym_count = 0;
-}
+#define is_reserved rs__is_reserved
 
 /* |v| without overflow or underflow in the squares (0 for a zero vector,
  * not finite when a component is not). */
@@ -328,19 +237,80 @@ static int normalize(lp_vec3 v, lp_vec3 *out)
 }
 
 /* ------------------------------------------------------------------ */
+/* Values                                                              */
+/* ------------------------------------------------------------------ */
+
+static void set_float(val *v, double f)
+{
+    memset(v, 0, sizeof *v);
+    v->kind = VAL_FLOAT;
+    v->v[0] = f;
+}
+
+static void set_vector(val *v, int dim)
+{
+    v->kind = VAL_VECTOR;
+    v->vec = 1;
+    v->dim = dim;
+}
+
+static const char *kind_name(val_kind k)
+{
+    static const char *const names[] = { "a float", "a vector", "a string", "a pigment",
+                                         "a finish", "a texture", "an interior", "an object" };
+    return names[k];
+}
+
+/* A float becomes <f,f,f,f,f> (POV-Ray's promotion); a vector keeps its
+ * components and gets at least dim of them (the new ones 0). */
+static void promote_to(val *v, int dim)
+{
+    if (v->kind == VAL_FLOAT) {
+        for (int i = 1; i < 5; i++)
+            v->v[i] = v->v[0];
+        set_vector(v, dim);
+    } else if (v->dim < dim) {
+        v->dim = dim;
+    }
+}
+
+static void promote(val *v)
+{
+    promote_to(v, 3);
+}
+
+static int val_finite(const val *v)
+{
+    for (int i = 0; i < 5; i++)
+        if (!isfinite(v->v[i]))
+            return 0;
+    return 1;
+}
+
+static int want_number(parser *p, val *v, const rs_token *start, const char *what)
+{
+    if (v->kind == VAL_FLOAT || v->kind == VAL_VECTOR)
+        return 0;
+    rs__val_free(v);
+    return error_at(p, start->line, start->column, "expected %s, found %s", what,
+                    kind_name(v->kind));
+}
+
+/* ------------------------------------------------------------------ */
 /* Expressions                                                         */
 /* ------------------------------------------------------------------ */
 
 enum fn_id {
     FN_SQRT, FN_SIN, FN_COS, FN_TAN, FN_ASIN, FN_ACOS, FN_ATAN, FN_ATAN2, FN_POW, FN_ABS,
     FN_MIN, FN_MAX, FN_RADIANS, FN_DEGREES, FN_EXP, FN_LN, FN_LOG, FN_FLOOR, FN_CEIL,
-    FN_INT, FN_MOD, FN_VLENGTH, FN_VNORMALIZE, FN_VDOT, FN_VCROSS
+    FN_INT, FN_MOD, FN_VLENGTH, FN_VNORMALIZE, FN_VDOT, FN_VCROSS, FN_SELECT, FN_DIV,
+    FN_STRLEN
 };
 
 typedef struct fn_def {
     const char *name;
     enum fn_id id;
-    int nargs;      /* -1: two or more */
+    int nargs;      /* -1: two or more; -3: three or four */
     int vec_args;   /* arguments are vectors (floats promote) */
     int vec_result;
 } fn_def;
@@ -359,6 +329,8 @@ static const fn_def functions[] = {
     { "mod", FN_MOD, 2, 0, 0 },         { "vlength", FN_VLENGTH, 1, 1, 0 },
     { "vnormalize", FN_VNORMALIZE, 1, 1, 1 },
     { "vdot", FN_VDOT, 2, 1, 0 },       { "vcross", FN_VCROSS, 2, 1, 1 },
+    { "select", FN_SELECT, -3, 0, 0 },  { "div", FN_DIV, 2, 0, 0 },
+    { "strlen", FN_STRLEN, 1, 0, 0 },
 };
 
 static const fn_def *find_function(const rs_token *t)
@@ -375,12 +347,12 @@ static const fn_def *find_function(const rs_token *t)
 static int builtin_value(const parser *p, const rs_token *t, val *out)
 {
     static const char *const ones[] = { "true", "on", "yes" };
-    static const char *const zeros[] = { "false", "off", "no" };
-    memset(out, 0, sizeof *out);
+    static const char *const zeros[] = { "false", "off", "no", "clock" };
+    set_float(out, 0.0);
     if (t->kind != RS_TOK_IDENT)
         return 0;
     if (t->len == 1 && (t->text[0] == 'x' || t->text[0] == 'y' || t->text[0] == 'z')) {
-        out->vec = 1;
+        set_vector(out, 3);
         out->v[t->text[0] - 'x'] = 1.0;
         return 1;
     }
@@ -396,14 +368,22 @@ static int builtin_value(const parser *p, const rs_token *t, val *out)
         out->v[0] = p->image_height;
         return 1;
     }
-    for (int i = 0; i < 3; i++) {
+    if (is_id(t, "version")) {
+        out->v[0] = p->version;
+        return 1;
+    }
+    if (p->allow_inf && is_id(t, "inf")) {
+        out->v[0] = INFINITY;
+        return 1;
+    }
+    for (int i = 0; i < 3; i++)
         if (is_id(t, ones[i])) {
             out->v[0] = 1.0;
             return 1;
         }
+    for (int i = 0; i < 4; i++)
         if (is_id(t, zeros[i]))
             return 1;
-    }
     return 0;
 }
 
@@ -415,47 +395,49 @@ static int is_expr_start(parser *p, const rs_token *t)
     if (t->kind == RS_TOK_NUMBER)
         return 1;
     if (t->kind == RS_TOK_PUNCT)
-        return t->punct == '(' || t->punct == '<' || t->punct == '-' || t->punct == '+';
+        return t->punct == '(' || t->punct == '<' || t->punct == '-' || t->punct == '+' ||
+               t->punct == '!';
     if (t->kind != RS_TOK_IDENT)
         return 0;
     return builtin_value(p, t, &dummy) || find_function(t) != NULL ||
            !is_reserved(t->text, t->len);
 }
 
-static int is_color_start(parser *p, const rs_token *t)
+static int is_color_keyword(const rs_token *t)
 {
     static const char *const kws[] = { "color", "colour", "rgb", "rgbf", "rgbt", "rgbft",
                                        "red", "green", "blue", "filter", "transmit" };
     for (size_t i = 0; i < sizeof kws / sizeof kws[0]; i++)
         if (is_id(t, kws[i]))
             return 1;
-    return is_expr_start(p, t);
+    return 0;
 }
 
-static void promote(val *v)
+static int is_color_start(parser *p, const rs_token *t)
 {
-    if (!v->vec) {
-        v->vec = 1;
-        v->v[1] = v->v[2] = v->v[0];
-    }
-}
-
-static int val_finite(const val *v)
-{
-    int n = v->vec ? 3 : 1;
-    for (int i = 0; i < n; i++)
-        if (!isfinite(v->v[i]))
-            return 0;
-    return 1;
+    return is_color_keyword(t) || is_expr_start(p, t);
 }
 
 static int parse_expr(parser *p, val *out);
+int rs__parse_expr(parser *p, val *out)
+{
+    return parse_expr(p, out);
+}
+
+/* An expression that must be a float or vector (what names it). */
+static int parse_number(parser *p, val *out, const char *what)
+{
+    rs_token start = *peek(p);
+    if (parse_expr(p, out) != 0)
+        return -1;
+    return want_number(p, out, &start, what);
+}
 
 static int want_float_val(parser *p, const val *v, const rs_token *start, const char *what)
 {
-    if (v->vec)
-        return error_at(p, start->line, start->column, "expected a float%s%s, found a vector",
-                        what ? " for " : "", what ? what : "");
+    if (v->kind != VAL_FLOAT)
+        return error_at(p, start->line, start->column, "expected a float%s%s, found %s",
+                        what ? " for " : "", what ? what : "", kind_name(v->kind));
     return 0;
 }
 
@@ -463,7 +445,7 @@ static int want_float_val(parser *p, const val *v, const rs_token *start, const 
 static int parse_function(parser *p, const fn_def *fn, val *out)
 {
     rs_token name = take(p);
-    val a[2];
+    val a[4];
     double r = 0.0;
     int nargs = 0;
     char what[48];
@@ -474,18 +456,30 @@ static int parse_function(parser *p, const fn_def *fn, val *out)
     if (enter(p, peek(p)) != 0)
         return -1;
     take(p);
-    memset(out, 0, sizeof *out);
+    memset(a, 0, sizeof a);
+    set_float(out, 0.0);
     for (;;) {
         rs_token start = *peek(p);
         val v;
-        if (parse_expr(p, &v) != 0)
+        if (fn->id == FN_STRLEN) {
+            char *str = NULL;
+            if (rs__parse_string(p, &str) != 0)
+                return -1;
+            set_float(&v, (double)strlen(str));
+            free(str);
+        } else if (parse_expr(p, &v) != 0) {
             return -1;
+        }
         if (fn->vec_args) {
+            if (want_number(p, &v, &start, "a vector argument") != 0)
+                return -1;
             promote(&v);
         } else {
             snprintf(what, sizeof what, "the argument of %s()", fn->name);
-            if (want_float_val(p, &v, &start, what) != 0)
+            if (want_float_val(p, &v, &start, what) != 0) {
+                rs__val_free(&v);
                 return -1;
+            }
         }
         if (fn->id == FN_MIN || fn->id == FN_MAX) {
             if (nargs == 0)
@@ -496,14 +490,15 @@ static int parse_function(parser *p, const fn_def *fn, val *out)
             a[nargs] = v;
         }
         nargs++;
-        if (fn->nargs > 0 && nargs == fn->nargs) {
+        if ((fn->nargs > 0 && nargs == fn->nargs) || (fn->nargs == -3 && nargs == 4)) {
             snprintf(what, sizeof what, "')' after the %s of %s()",
                      nargs == 1 ? "argument" : "arguments", fn->name);
             if (expect_punct(p, ')', what) != 0)
                 return -1;
             break;
         }
-        if (fn->nargs < 0 && nargs >= 2 && is_punct(peek(p), ')')) {
+        if (((fn->nargs == -1 && nargs >= 2) || (fn->nargs == -3 && nargs == 3)) &&
+            is_punct(peek(p), ')')) {
             take(p);
             break;
         }
@@ -533,10 +528,22 @@ static int parse_function(parser *p, const fn_def *fn, val *out)
     case FN_FLOOR: r = floor(a[0].v[0]); break;
     case FN_CEIL: r = ceil(a[0].v[0]); break;
     case FN_INT: r = trunc(a[0].v[0]); break;
+    case FN_STRLEN: r = a[0].v[0]; break;
     case FN_MOD:
+    case FN_DIV:
         if (a[1].v[0] == 0.0)
-            return error_at(p, name.line, name.column, "mod(): division by zero");
-        r = fmod(a[0].v[0], a[1].v[0]);
+            return error_at(p, name.line, name.column, "%s(): division by zero", fn->name);
+        r = fn->id == FN_MOD ? fmod(a[0].v[0], a[1].v[0]) : trunc(a[0].v[0] / a[1].v[0]);
+        break;
+    case FN_SELECT:
+        /* select(A, B, C [, D]): B if A < 0, C if A = 0 (or >= 0 with three
+         * arguments), D if A > 0 */
+        if (a[0].v[0] < 0.0)
+            r = a[1].v[0];
+        else if (nargs == 3 || a[0].v[0] == 0.0)
+            r = a[2].v[0];
+        else
+            r = a[3].v[0];
         break;
     case FN_VLENGTH:
         r = vec_length((lp_vec3){ a[0].v[0], a[0].v[1], a[0].v[2] });
@@ -545,7 +552,7 @@ static int parse_function(parser *p, const fn_def *fn, val *out)
         lp_vec3 u;
         if (!normalize((lp_vec3){ a[0].v[0], a[0].v[1], a[0].v[2] }, &u))
             return error_at(p, name.line, name.column, "vnormalize() of a zero vector");
-        out->vec = 1;
+        set_vector(out, 3);
         out->v[0] = u.x;
         out->v[1] = u.y;
         out->v[2] = u.z;
@@ -555,7 +562,7 @@ static int parse_function(parser *p, const fn_def *fn, val *out)
         r = a[0].v[0] * a[1].v[0] + a[0].v[1] * a[1].v[1] + a[0].v[2] * a[1].v[2];
         break;
     case FN_VCROSS:
-        out->vec = 1;
+        set_vector(out, 3);
         out->v[0] = a[0].v[1] * a[1].v[2] - a[0].v[2] * a[1].v[1];
         out->v[1] = a[0].v[2] * a[1].v[0] - a[0].v[0] * a[1].v[2];
         out->v[2] = a[0].v[0] * a[1].v[1] - a[0].v[1] * a[1].v[0];
@@ -569,26 +576,42 @@ static int parse_function(parser *p, const fn_def *fn, val *out)
     return 0;
 }
 
+/* < a, b, c [, d [, e]] >: the components are read without the
+ * comparisons < and > (the closing '>'), unless in parentheses. */
 static int parse_vector_literal(parser *p, val *out)
 {
-    static const char *const seps[] = { "',' after the first vector component",
-                                        "',' after the second vector component",
-                                        "'>' to close the vector" };
     rs_token open = take(p);
+    int saved = p->in_vector, n = 0;
     if (enter(p, &open) != 0)
         return -1;
-    out->vec = 1;
-    for (int i = 0; i < 3; i++) {
+    set_float(out, 0.0);
+    p->in_vector = 1;
+    for (;;) {
         rs_token start = *peek(p);
         val c;
         if (parse_expr(p, &c) != 0)
             return -1;
-        if (want_float_val(p, &c, &start, "a vector component") != 0)
-            return -1;
-        out->v[i] = c.v[0];
-        if (expect_punct(p, i < 2 ? ',' : '>', seps[i]) != 0)
-            return -1;
+        if (c.kind != VAL_FLOAT) {
+            rs__val_free(&c);
+            return error_at(p, start.line, start.column,
+                            "expected a float for a vector component, found %s",
+                            kind_name(c.kind));
+        }
+        out->v[n++] = c.v[0];
+        if (n >= 3 && is_punct(peek(p), '>'))
+            break;
+        if (n == 5)
+            return expected(p, peek(p), "'>' to close the vector");
+        if (n < 3 && !is_punct(peek(p), ','))
+            return expected(p, peek(p), n == 1 ? "',' after the first vector component"
+                                               : "',' after the second vector component");
+        if (!is_punct(peek(p), ','))
+            return expected(p, peek(p), "',' or '>' in the vector");
+        take(p);
     }
+    take(p);
+    p->in_vector = saved;
+    set_vector(out, n);
     leave(p);
     return 0;
 }
@@ -599,24 +622,34 @@ static int parse_primary(parser *p, val *out)
     const fn_def *fn;
     sym *s;
 
-    memset(out, 0, sizeof *out);
+    set_float(out, 0.0);
     if (t->kind == RS_TOK_NUMBER) {
         out->v[0] = take(p).number;
         return 0;
     }
     if (is_punct(t, '(')) {
+        int saved = p->in_vector;
         if (enter(p, t) != 0)
             return -1;
         take(p);
+        p->in_vector = 0;
         if (parse_expr(p, out) != 0)
             return -1;
-        if (expect_punct(p, ')', "')'") != 0)
+        p->in_vector = saved;
+        if (expect_punct(p, ')', "')'") != 0) {
+            rs__val_free(out);
             return -1;
+        }
         leave(p);
         return 0;
     }
     if (is_punct(t, '<'))
         return parse_vector_literal(p, out);
+    if (t->kind == RS_TOK_STRING || is_id(t, "concat") || is_id(t, "str") || is_id(t, "chr")) {
+        set_float(out, 0.0);
+        out->kind = VAL_STRING;
+        return rs__parse_string(p, &out->str);
+    }
     if (t->kind == RS_TOK_IDENT) {
         if (builtin_value(p, t, out)) {
             take(p);
@@ -624,8 +657,9 @@ static int parse_primary(parser *p, val *out)
         }
         if ((fn = find_function(t)) != NULL)
             return parse_function(p, fn, out);
-        if ((s = sym_find(p, t->text, t->len)) != NULL) {
-            *out = s->v;
+        if ((s = rs__sym_find(p, t->text, t->len)) != NULL) {
+            if (rs__val_copy(&s->v, out) != 0)
+                return error_at(p, t->line, t->column, "out of memory");
             take(p);
             return 0;
         }
@@ -637,65 +671,97 @@ static int parse_primary(parser *p, val *out)
     return expected(p, t, "an expression");
 }
 
-/* primary { . x|y|z|red|green|blue } */
+/* primary { . x|y|z|u|v|red|green|blue|filter|transmit|t } */
 static int parse_postfix(parser *p, val *out)
 {
     if (parse_primary(p, out) != 0)
         return -1;
     while (is_punct(peek(p), '.')) {
+        static const struct { const char *name; int k; } comps[] = {
+            { "x", 0 }, { "u", 0 }, { "red", 0 }, { "y", 1 }, { "v", 1 }, { "green", 1 },
+            { "z", 2 }, { "blue", 2 }, { "filter", 3 }, { "transmit", 4 }, { "t", 4 },
+        };
         rs_token dot = take(p);
         const rs_token *c = peek(p);
         int k = -1;
-        if (is_id(c, "x") || is_id(c, "red"))
-            k = 0;
-        else if (is_id(c, "y") || is_id(c, "green"))
-            k = 1;
-        else if (is_id(c, "z") || is_id(c, "blue"))
-            k = 2;
-        if (k < 0)
-            return expected(p, c, "x, y, z, red, green or blue after '.'");
-        if (!out->vec)
-            return error_at(p, dot.line, dot.column, "'.' needs a vector, found a float");
+        for (size_t i = 0; i < sizeof comps / sizeof comps[0]; i++)
+            if (is_id(c, comps[i].name))
+                k = comps[i].k;
+        if (k < 0) {
+            rs__val_free(out);
+            return expected(p, c, "x, y, z, red, green, blue, filter or transmit after '.'");
+        }
+        if (out->kind != VAL_VECTOR) {
+            rs__val_free(out);
+            return error_at(p, dot.line, dot.column, "'.' needs a vector, found %s",
+                            kind_name(out->kind));
+        }
         take(p);
-        out->vec = 0;
-        out->v[0] = out->v[k];
-        out->v[1] = out->v[2] = 0.0;
+        set_float(out, out->v[k]);
     }
     return 0;
 }
 
-/* A run of unary signs, read in a loop (no recursion). */
+/* A run of unary signs and '!', read in a loop (no recursion). */
 static int parse_unary(parser *p, val *out)
 {
-    int neg = 0;
-    while (is_punct(peek(p), '-') || is_punct(peek(p), '+')) {
-        if (take(p).punct == '-')
+    int neg = 0, nots = 0;
+    rs_token start = *peek(p);
+    while (is_punct(peek(p), '-') || is_punct(peek(p), '+') || is_punct(peek(p), '!')) {
+        rs_token op = take(p);
+        if (op.punct == '-')
             neg = !neg;
+        else if (op.punct == '!')
+            nots++;
     }
     if (parse_postfix(p, out) != 0)
         return -1;
+    if ((neg || nots) && want_number(p, out, &start, "a number after a sign") != 0)
+        return -1;
     if (neg)
-        for (int i = 0; i < 3; i++)
+        for (int i = 0; i < 5; i++)
             out->v[i] = -out->v[i];
+    if (nots) {
+        if (out->kind != VAL_FLOAT)
+            return error_at(p, start.line, start.column, "'!' needs a float, found a vector");
+        if (nots & 1)
+            out->v[0] = out->v[0] == 0.0 ? 1.0 : 0.0;
+        else
+            out->v[0] = out->v[0] != 0.0;
+    }
     return 0;
 }
 
 static int binary(parser *p, const rs_token *op, val *a, val b)
 {
-    int n;
-    if (a->vec || b.vec) {
-        promote(a);
-        promote(&b);
+    int dim;
+    if (a->kind != VAL_FLOAT && a->kind != VAL_VECTOR) {
+        rs__val_free(&b);
+        rs__val_free(a);
+        return error_at(p, op->line, op->column, "'%c' needs numbers on its left", op->punct);
     }
-    n = a->vec ? 3 : 1;
-    for (int i = 0; i < n; i++) {
+    if (b.kind != VAL_FLOAT && b.kind != VAL_VECTOR) {
+        rs__val_free(&b);
+        return error_at(p, op->line, op->column, "'%c' needs numbers on its right", op->punct);
+    }
+    if (a->kind == VAL_VECTOR || b.kind == VAL_VECTOR) {
+        dim = a->kind == VAL_VECTOR ? a->dim : 3;
+        if (b.kind == VAL_VECTOR && b.dim > dim)
+            dim = b.dim;
+        promote_to(a, dim);
+        promote_to(&b, dim);
+    }
+    for (int i = 0; i < 5; i++) {
         switch (op->punct) {
         case '+': a->v[i] += b.v[i]; break;
         case '-': a->v[i] -= b.v[i]; break;
         case '*': a->v[i] *= b.v[i]; break;
         default:
-            if (b.v[i] == 0.0)
+            if (b.v[i] == 0.0) {
+                if (i >= (a->kind == VAL_VECTOR ? a->dim : 1))
+                    continue; /* padding of a shorter vector */
                 return error_at(p, op->line, op->column, "division by zero");
+            }
             a->v[i] /= b.v[i];
             break;
         }
@@ -719,7 +785,7 @@ static int parse_term(parser *p, val *out)
     return 0;
 }
 
-static int parse_expr(parser *p, val *out)
+static int parse_sum(parser *p, val *out)
 {
     if (parse_term(p, out) != 0)
         return -1;
@@ -732,12 +798,146 @@ static int parse_expr(parser *p, val *out)
     return 0;
 }
 
+/* a OP b for the comparisons and & |: both floats, result 0 or 1. */
+static int compare(parser *p, const rs_token *op, const char *name, val *a, val *b, double r)
+{
+    if (a->kind != VAL_FLOAT || b->kind != VAL_FLOAT) {
+        rs__val_free(a);
+        rs__val_free(b);
+        return error_at(p, op->line, op->column, "'%s' needs floats on both sides", name);
+    }
+    set_float(a, r);
+    return 0;
+}
+
+/* sum [ < <= = != >= > sum ]: '<' only after a float (after a vector it
+ * starts the next vector), '>' not inside a vector literal. */
+static int parse_relation(parser *p, val *out)
+{
+    if (parse_sum(p, out) != 0)
+        return -1;
+    for (;;) {
+        const rs_token *t = peek(p);
+        rs_token op;
+        char name[3] = { 0, 0, 0 };
+        val b;
+        double x, y, r;
+        if (!(is_punct(t, '=') || is_punct(t, '!') ||
+              (!p->in_vector && out->kind == VAL_FLOAT &&
+               (is_punct(t, '<') || is_punct(t, '>')))))
+            return 0;
+        op = take(p);
+        name[0] = op.punct;
+        if (op.punct != '=' && is_punct(peek(p), '=')) {
+            take(p);
+            name[1] = '=';
+        } else if (op.punct == '!') {
+            return expected(p, peek(p), "'=' after '!'");
+        }
+        if (parse_sum(p, &b) != 0)
+            return -1;
+        x = out->v[0];
+        y = b.v[0];
+        if (name[0] == '=')
+            r = x == y;
+        else if (name[0] == '!')
+            r = x != y;
+        else if (name[0] == '<')
+            r = name[1] ? x <= y : x < y;
+        else
+            r = name[1] ? x >= y : x > y;
+        if (compare(p, &op, name, out, &b, r) != 0)
+            return -1;
+    }
+}
+
+static int parse_and(parser *p, val *out)
+{
+    if (parse_relation(p, out) != 0)
+        return -1;
+    while (is_punct(peek(p), '&')) {
+        rs_token op = take(p);
+        val b;
+        if (parse_relation(p, &b) != 0)
+            return -1;
+        if (compare(p, &op, "&", out, &b, out->v[0] != 0.0 && b.v[0] != 0.0) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+static int parse_or(parser *p, val *out)
+{
+    if (parse_and(p, out) != 0)
+        return -1;
+    while (is_punct(peek(p), '|')) {
+        rs_token op = take(p);
+        val b;
+        if (parse_and(p, &b) != 0)
+            return -1;
+        if (compare(p, &op, "|", out, &b, out->v[0] != 0.0 || b.v[0] != 0.0) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* or [ ? expr : expr ] (both branches are read; one is kept). */
+static int parse_ternary(parser *p, val *out)
+{
+    rs_token q;
+    val a, b;
+    if (parse_or(p, out) != 0)
+        return -1;
+    if (!is_punct(peek(p), '?'))
+        return 0;
+    q = take(p);
+    if (out->kind != VAL_FLOAT) {
+        rs__val_free(out);
+        return error_at(p, q.line, q.column, "'?' needs a float condition");
+    }
+    if (enter(p, &q) != 0)
+        return -1;
+    if (parse_expr(p, &a) != 0)
+        return -1;
+    if (expect_punct(p, ':', "':' in 'c ? a : b'") != 0) {
+        rs__val_free(&a);
+        return -1;
+    }
+    if (parse_expr(p, &b) != 0) {
+        rs__val_free(&a);
+        return -1;
+    }
+    leave(p);
+    if (out->v[0] != 0.0) {
+        *out = a;
+        rs__val_free(&b);
+    } else {
+        *out = b;
+        rs__val_free(&a);
+    }
+    return 0;
+}
+
+/* An expression; on failure *out holds nothing to free. */
+static int parse_expr(parser *p, val *out)
+{
+    if (parse_ternary(p, out) != 0) {
+        rs__val_free(out);
+        return -1;
+    }
+    return 0;
+}
+
 static int parse_float(parser *p, const char *what, double *out)
 {
     rs_token start = *peek(p);
     val v;
-    if (parse_expr(p, &v) != 0 || want_float_val(p, &v, &start, what) != 0)
+    if (parse_expr(p, &v) != 0)
         return -1;
+    if (want_float_val(p, &v, &start, what) != 0) {
+        rs__val_free(&v);
+        return -1;
+    }
     *out = v.v[0];
     return 0;
 }
@@ -745,7 +945,7 @@ static int parse_float(parser *p, const char *what, double *out)
 static int parse_vector(parser *p, lp_vec3 *out)
 {
     val v;
-    if (parse_expr(p, &v) != 0)
+    if (parse_number(p, &v, "a vector") != 0)
         return -1;
     promote(&v);
     out->x = v.v[0];
@@ -766,67 +966,207 @@ static int parse_nonzero_vector(parser *p, const char *what, lp_vec3 *out)
 }
 
 /* ------------------------------------------------------------------ */
+/* Strings                                                             */
+/* ------------------------------------------------------------------ */
+
+static int append(parser *p, const rs_token *at, char *buf, size_t *len, const char *s, size_t n)
+{
+    if (*len + n >= MAX_STRING)
+        return error_at(p, at->line, at->column, "a string longer than %d bytes",
+                        MAX_STRING - 1);
+    memcpy(buf + *len, s, n);
+    *len += n;
+    buf[*len] = '\0';
+    return 0;
+}
+
+/* "literal" | concat(S, ...) | str(F, W, P) | chr(F) | a string identifier. */
+int rs__parse_string(parser *p, char **out)
+{
+    const rs_token *t = peek(p);
+    rs_token at = *t;
+    char buf[MAX_STRING];
+    size_t len = 0;
+    sym *s;
+
+    *out = NULL;
+    buf[0] = '\0';
+    if (t->kind == RS_TOK_STRING) {
+        int n = rs_string_decode(t, buf, sizeof buf);
+        if (n < 0)
+            return error_at(p, t->line, t->column, "a string longer than %d bytes",
+                            MAX_STRING - 1);
+        take(p);
+    } else if (is_id(t, "concat")) {
+        take(p);
+        if (enter(p, &at) != 0 || expect_punct(p, '(', "'(' after 'concat'") != 0)
+            return -1;
+        for (;;) {
+            char *part;
+            if (rs__parse_string(p, &part) != 0)
+                return -1;
+            if (append(p, &at, buf, &len, part, strlen(part)) != 0) {
+                free(part);
+                return -1;
+            }
+            free(part);
+            if (!is_punct(peek(p), ','))
+                break;
+            take(p);
+        }
+        if (expect_punct(p, ')', "',' or ')' in concat()") != 0)
+            return -1;
+        leave(p);
+    } else if (is_id(t, "str")) {
+        double f, w, prec;
+        char num[400];
+        take(p);
+        if (enter(p, &at) != 0 || expect_punct(p, '(', "'(' after 'str'") != 0 ||
+            parse_float(p, "str()", &f) != 0 || expect_punct(p, ',', "',' in str()") != 0 ||
+            parse_float(p, "str()", &w) != 0 || expect_punct(p, ',', "',' in str()") != 0 ||
+            parse_float(p, "str()", &prec) != 0 || expect_punct(p, ')', "')' after str()") != 0)
+            return -1;
+        leave(p);
+        if (!(fabs(w) <= 64.0) || !(prec <= 64.0))
+            return error_at(p, at.line, at.column, "str(): width and precision must be at "
+                                                   "most 64");
+        /* POV-Ray: a negative width pads with zeros, a negative precision
+         * means as many digits as needed */
+        if (prec < 0.0)
+            snprintf(num, sizeof num, w < 0 ? "%0*g" : "%*g", (int)fabs(w), f);
+        else
+            snprintf(num, sizeof num, w < 0 ? "%0*.*f" : "%*.*f", (int)fabs(w), (int)prec, f);
+        if (append(p, &at, buf, &len, num, strlen(num)) != 0)
+            return -1;
+    } else if (is_id(t, "chr")) {
+        double f;
+        char c;
+        take(p);
+        if (enter(p, &at) != 0 || expect_punct(p, '(', "'(' after 'chr'") != 0 ||
+            parse_float(p, "chr()", &f) != 0 || expect_punct(p, ')', "')' after chr()") != 0)
+            return -1;
+        leave(p);
+        if (!(f >= 1.0 && f < 256.0))
+            return error_at(p, at.line, at.column, "chr(): a code from 1 to 255");
+        c = (char)(unsigned char)f;
+        if (append(p, &at, buf, &len, &c, 1) != 0)
+            return -1;
+    } else if (t->kind == RS_TOK_IDENT && (s = rs__sym_find(p, t->text, t->len)) != NULL &&
+               s->v.kind == VAL_STRING) {
+        snprintf(buf, sizeof buf, "%s", s->v.str);
+        take(p);
+    } else {
+        return expected(p, t, "a string");
+    }
+    len = strlen(buf);
+    if ((*out = malloc(len + 1)) == NULL)
+        return error_at(p, at.line, at.column, "out of memory");
+    memcpy(*out, buf, len + 1);
+    return 0;
+}
+
+/* ------------------------------------------------------------------ */
 /* Colours                                                             */
 /* ------------------------------------------------------------------ */
 
 static const char transparent_msg[] =
     "transparent pigments are not supported: use a lens object";
 
-/* [color|colour] rgb V | V | red/green/blue F ...  In a pigment (and a
- * declared colour) a lone non-zero float is refused: POV-Ray would set
- * filter and transmit to it as well. */
-static int parse_color(parser *p, int opaque_only, rs_color *out)
+/* [color|colour] (rgb V | rgbf V | rgbt V | rgbft V | V) and then
+ * red/green/blue/filter/transmit F, into c[0..5) (r g b filter transmit).
+ * A float V gives every component (POV-Ray), so `color 0.5` is also half
+ * transparent. */
+static int parse_color5(parser *p, double c[5])
 {
     const rs_token *t = peek(p);
     val v;
     int any = 0;
 
-    memset(&v, 0, sizeof v);
-    v.vec = 1;
+    set_float(&v, 0.0);
+    set_vector(&v, 5);
     if (is_id(t, "color") || is_id(t, "colour")) {
         take(p);
         t = peek(p);
     }
-    if (is_id(t, "rgbf") || is_id(t, "rgbt") || is_id(t, "rgbft") || is_id(t, "filter") ||
-        is_id(t, "transmit")) {
-        return error_at(p, t->line, t->column, "%s", transparent_msg);
-    } else if (is_id(t, "rgb")) {
-        take(p);
-        if (parse_expr(p, &v) != 0)
+    if (is_id(t, "rgb") || is_id(t, "rgbf") || is_id(t, "rgbt") || is_id(t, "rgbft")) {
+        rs_token kw = take(p);
+        int n = (int)kw.len - 3 + 3; /* rgb 3, rgbf/rgbt 4, rgbft 5 */
+        rs_token start = *peek(p);
+        val w;
+        if (parse_number(p, &w, "a colour") != 0)
             return -1;
-        promote(&v);
+        if (w.kind == VAL_FLOAT) {
+            for (int i = 0; i < n; i++)
+                v.v[i] = w.v[0];
+        } else {
+            if (w.dim < n && !(w.dim == 3 && n > 3))
+                return error_at(p, start.line, start.column, "%.*s needs %d components",
+                                (int)kw.len, kw.text, n);
+            for (int i = 0; i < 3; i++)
+                v.v[i] = w.v[i];
+            if (n == 4)
+                v.v[is_id(&kw, "rgbt") ? 4 : 3] = w.dim > 3 ? w.v[3] : 0.0;
+            if (n == 5) {
+                v.v[3] = w.dim > 3 ? w.v[3] : 0.0;
+                v.v[4] = w.dim > 4 ? w.v[4] : 0.0;
+            }
+        }
+        if (n == 4 && w.kind == VAL_FLOAT && is_id(&kw, "rgbt")) {
+            v.v[4] = v.v[3];
+            v.v[3] = 0.0;
+        }
         any = 1;
-    } else if (!(is_id(t, "red") || is_id(t, "green") || is_id(t, "blue"))) {
-        rs_token start = *t;
+    } else if (!(is_id(t, "red") || is_id(t, "green") || is_id(t, "blue") ||
+                 is_id(t, "filter") || is_id(t, "transmit"))) {
+        val w;
         if (!is_expr_start(p, t))
             return expected(p, t, "a colour");
-        if (parse_expr(p, &v) != 0)
+        if (parse_number(p, &w, "a colour") != 0)
             return -1;
-        if (!v.vec && v.v[0] != 0.0 && opaque_only)
-            return error_at(p, start.line, start.column,
-                            "%s (a lone float colour also sets filter and transmit in "
-                            "POV-Ray; write rgb %g)", transparent_msg, v.v[0]);
-        promote(&v);
+        promote_to(&w, 5);
+        for (int i = 0; i < 5; i++)
+            v.v[i] = w.v[i];
         any = 1;
     }
     for (;;) {
-        int k;
+        static const char *const names[] = { "red", "green", "blue", "filter", "transmit" };
+        int k = -1;
         t = peek(p);
-        if (is_id(t, "filter") || is_id(t, "transmit"))
-            return error_at(p, t->line, t->column, "%s", transparent_msg);
-        k = is_id(t, "red") ? 0 : is_id(t, "green") ? 1 : is_id(t, "blue") ? 2 : -1;
+        for (int i = 0; i < 5; i++)
+            if (is_id(t, names[i]))
+                k = i;
         if (k < 0)
             break;
         take(p);
-        if (parse_float(p, k == 0 ? "red" : k == 1 ? "green" : "blue", &v.v[k]) != 0)
+        if (parse_float(p, names[k], &v.v[k]) != 0)
             return -1;
         any = 1;
     }
     if (!any)
         return expected(p, peek(p), "a colour");
-    out->r = v.v[0];
-    out->g = v.v[1];
-    out->b = v.v[2];
+    for (int i = 0; i < 5; i++)
+        c[i] = v.v[i];
+    return 0;
+}
+
+/* A colour where only an opaque one makes sense (opaque_only: a pigment;
+ * else filter and transmit are dropped: light colours, finishes). */
+static int parse_color(parser *p, int opaque_only, rs_color *out)
+{
+    rs_token start = *peek(p);
+    double c[5];
+    if (parse_color5(p, c) != 0)
+        return -1;
+    if (opaque_only && (c[3] != 0.0 || c[4] != 0.0))
+        return error_at(p, start.line, start.column,
+                        "%s (filter %g, transmit %g)%s", transparent_msg, c[3], c[4],
+                        (c[0] == c[3] && c[1] == c[3] && c[2] == c[3] && c[4] == c[3])
+                            ? " -- a lone float colour also sets filter and transmit in "
+                              "POV-Ray; write rgb V"
+                            : "");
+    out->r = c[0];
+    out->g = c[1];
+    out->b = c[2];
     return 0;
 }
 
@@ -907,9 +1247,24 @@ static void default_pigment(rs_pigment *pig)
 
 static void default_finish(rs_finish *f)
 {
+    memset(f, 0, sizeof *f);
     f->ambient = (rs_color){ 0.1, 0.1, 0.1 };
     f->diffuse = 0.6;
+    f->brilliance = 1.0;
     f->emission = (rs_color){ 0.0, 0.0, 0.0 };
+    f->phong_size = 40.0;
+    f->roughness = 0.05;
+}
+
+/* A declared value of the given kind named by the current token, or NULL. */
+static sym *declared(parser *p, val_kind kind)
+{
+    const rs_token *t = peek(p);
+    sym *s;
+    if (t->kind != RS_TOK_IDENT)
+        return NULL;
+    s = rs__sym_find(p, t->text, t->len);
+    return s != NULL && s->v.kind == kind ? s : NULL;
 }
 
 /* pigment { ... }: modifies *pig; *pat is the pigment's pattern -> world
@@ -931,6 +1286,12 @@ static int parse_pigment(parser *p, rs_pigment *pig, rs_transform *pat)
             if (parse_transform_step(p, &step, &v, &kw) != 0 ||
                 apply_step(p, &kw, pat, &step) != 0)
                 return -1;
+        } else if (!has_pattern && declared(p, VAL_PIGMENT) != NULL) {
+            const rs_pigment_val *pv = declared(p, VAL_PIGMENT)->v.ptr;
+            take(p);
+            *pig = pv->pig;
+            *pat = pv->pat;
+            has_pattern = 1;
         } else if (!has_pattern && is_id(t, "checker")) {
             take(p);
             pig->type = RS_PIGMENT_CHECKER;
@@ -962,14 +1323,72 @@ static int parse_pigment(parser *p, rs_pigment *pig, rs_transform *pat)
     return close_block(p, "pigment");
 }
 
+/* reflection F | C | { [C_MIN ,] C_MAX [fresnel [BOOL]] [falloff F] [exponent F]
+ * [metallic [F]] } (the last three are read and warned about). */
+static int parse_reflection(parser *p, rs_finish *f)
+{
+    rs_color a, b;
+    if (!is_punct(peek(p), '{')) {
+        if (parse_color(p, 0, &a) != 0)
+            return -1;
+        f->reflection_min = f->reflection_max = a;
+        f->fresnel = 0;
+        return 0;
+    }
+    if (open_block(p, "reflection") != 0 || parse_color(p, 0, &a) != 0)
+        return -1;
+    b = a;
+    if (is_punct(peek(p), ',')) {
+        take(p);
+        if (parse_color(p, 0, &b) != 0)
+            return -1;
+    }
+    f->reflection_min = a;
+    f->reflection_max = b;
+    f->fresnel = 0;
+    for (;;) {
+        const rs_token *t = peek(p);
+        if (is_punct(t, '}'))
+            break;
+        if (is_id(t, "fresnel")) {
+            double v = 1.0;
+            take(p);
+            if (is_expr_start(p, peek(p)) && parse_float(p, "fresnel", &v) != 0)
+                return -1;
+            f->fresnel = v != 0.0;
+        } else if (is_id(t, "falloff") || is_id(t, "exponent") || is_id(t, "metallic")) {
+            rs_token kw = take(p);
+            double v = 1.0;
+            if ((!is_id(&kw, "metallic") || is_expr_start(p, peek(p))) &&
+                parse_float(p, "the reflection parameter", &v) != 0)
+                return -1;
+            rs__warn(p, kw.line, kw.column, "reflection %.*s is read but not rendered",
+                     (int)kw.len, kw.text);
+        } else {
+            return expected(p, t, "fresnel, falloff, exponent, metallic or '}' in reflection");
+        }
+    }
+    return close_block(p, "reflection");
+}
+
 static int parse_finish(parser *p, rs_finish *f)
 {
-    static const char *const ignored[] = { "specular", "phong", "phong_size", "brilliance",
-                                           "roughness" };
     take(p);
     if (open_block(p, "finish") != 0)
         return -1;
+    if (declared(p, VAL_FINISH) != NULL) {
+        *f = *(const rs_finish *)declared(p, VAL_FINISH)->v.ptr;
+        take(p);
+    }
     for (;;) {
+        static const struct { const char *kw; size_t off; int positive; } floats[] = {
+            { "diffuse", offsetof(rs_finish, diffuse), 0 },
+            { "brilliance", offsetof(rs_finish, brilliance), 0 },
+            { "phong", offsetof(rs_finish, phong), 0 },
+            { "phong_size", offsetof(rs_finish, phong_size), 1 },
+            { "specular", offsetof(rs_finish, specular), 0 },
+            { "roughness", offsetof(rs_finish, roughness), 1 },
+        };
         const rs_token *t = peek(p);
         int done = 0;
         if (is_punct(t, '}'))
@@ -986,39 +1405,48 @@ static int parse_finish(parser *p, rs_finish *f)
                 return -1;
             continue;
         }
-        if (is_id(t, "diffuse")) {
+        if (is_id(t, "reflection")) {
             take(p);
-            if (parse_float(p, "diffuse", &f->diffuse) != 0)
-                return -1;
-            continue;
-        }
-        if (is_id(t, "reflection")) { /* read, not rendered */
-            rs_color ignore;
-            take(p);
-            if (parse_color(p, 0, &ignore) != 0)
+            if (parse_reflection(p, f) != 0)
                 return -1;
             continue;
         }
         if (is_id(t, "conserve_energy")) {
             take(p);
+            f->conserve_energy = 1;
             continue;
         }
-        for (size_t i = 0; i < sizeof ignored / sizeof ignored[0]; i++) {
-            if (is_id(t, ignored[i])) {
-                double ignore;
+        if (is_id(t, "metallic") || is_id(t, "crand") || is_id(t, "irid")) {
+            rs_token kw = take(p);
+            double v;
+            if (is_id(&kw, "irid"))
+                return error_at(p, kw.line, kw.column, "irid is not supported");
+            if (is_expr_start(p, peek(p)) && parse_float(p, "the finish parameter", &v) != 0)
+                return -1;
+            rs__warn(p, kw.line, kw.column, "finish %.*s is read but not rendered",
+                     (int)kw.len, kw.text);
+            continue;
+        }
+        for (size_t i = 0; i < sizeof floats / sizeof floats[0]; i++) {
+            if (is_id(t, floats[i].kw)) {
                 rs_token kw = take(p);
-                char what[32];
-                snprintf(what, sizeof what, "%.*s", (int)kw.len, kw.text);
-                if (parse_float(p, what, &ignore) != 0)
+                rs_token start = *peek(p);
+                double *dst = (double *)((char *)f + floats[i].off);
+                if (parse_float(p, floats[i].kw, dst) != 0)
                     return -1;
+                if (floats[i].positive ? !(*dst > 0.0) : !(*dst >= 0.0))
+                    return error_at(p, start.line, start.column, "%s must be %s",
+                                    floats[i].kw, floats[i].positive ? "positive"
+                                                                      : "at least 0");
+                (void)kw;
                 done = 1;
                 break;
             }
         }
         if (!done)
-            return expected(p, t, "ambient, diffuse, emission, specular, phong, phong_size, "
-                                   "brilliance, roughness, reflection, conserve_energy or "
-                                   "'}' in finish");
+            return expected(p, t, "ambient, diffuse, brilliance, emission, specular, roughness, "
+                                  "phong, phong_size, reflection, conserve_energy, metallic or "
+                                  "'}' in finish");
     }
     return close_block(p, "finish");
 }
@@ -1028,6 +1456,13 @@ static int parse_texture(parser *p, rs_pigment *pig, rs_transform *pat, rs_finis
     take(p);
     if (open_block(p, "texture") != 0)
         return -1;
+    if (declared(p, VAL_TEXTURE) != NULL) {
+        const rs_texture_val *tv = declared(p, VAL_TEXTURE)->v.ptr;
+        take(p);
+        *pig = tv->pig;
+        *pat = tv->pat;
+        *fin = tv->fin;
+    }
     for (;;) {
         const rs_token *t = peek(p);
         if (is_punct(t, '}'))
@@ -1057,7 +1492,7 @@ static int parse_texture(parser *p, rs_pigment *pig, rs_transform *pat, rs_finis
 /* ------------------------------------------------------------------ */
 
 static const char *const type_names[] = { "plane", "sphere", "box", "disc", "lens",
-                                          "polarizer" };
+                                          "polarizer", "cylinder", "cone", "torus" };
 
 static void object_init(rs_object *o, rs_object_type type, const parser *p, const rs_token *kw)
 {
@@ -1069,6 +1504,7 @@ static void object_init(rs_object *o, rs_object_type type, const parser *p, cons
     rs_transform_identity(&o->xf);
     default_pigment(&o->pigment);
     default_finish(&o->finish);
+    o->ior = 1.0;
     o->lens = NULL;
 }
 
@@ -1083,6 +1519,8 @@ static int check_room(parser *p, size_t n, const rs_token *kw, const char *what)
 static int push_object(parser *p, const rs_object *o, const rs_token *kw)
 {
     rs_scene *s = p->scene;
+    if (check_room(p, s->n_objects, kw, "objects") != 0)
+        return -1;
     if (s->n_objects == s->cap_objects) {
         size_t cap = s->cap_objects ? s->cap_objects * 2 : 16;
         rs_object *a;
@@ -1096,6 +1534,35 @@ static int push_object(parser *p, const rs_object *o, const rs_token *kw)
     }
     s->objects[s->n_objects++] = *o;
     return 0;
+}
+
+/* interior { ior F }: the index an opaque object's fresnel reflection uses. */
+static int parse_interior(parser *p, double *ior)
+{
+    take(p);
+    if (open_block(p, "interior") != 0)
+        return -1;
+    if (declared(p, VAL_INTERIOR) != NULL) {
+        *ior = *(const double *)declared(p, VAL_INTERIOR)->v.ptr;
+        take(p);
+    }
+    for (;;) {
+        const rs_token *t = peek(p);
+        if (is_punct(t, '}'))
+            break;
+        if (is_id(t, "ior")) {
+            rs_token start;
+            take(p);
+            start = *peek(p);
+            if (parse_float(p, "ior", ior) != 0)
+                return -1;
+            if (!(*ior > 0.0))
+                return error_at(p, start.line, start.column, "ior must be positive");
+        } else {
+            return expected(p, t, "ior or '}' in interior");
+        }
+    }
+    return close_block(p, "interior");
 }
 
 /* pigment / finish / texture / transforms until '}'.  The pigment's
@@ -1115,12 +1582,21 @@ static int parse_object_modifiers(parser *p, rs_object *o)
         if (is_id(t, "pigment")) {
             if (parse_pigment(p, &o->pigment, &pat) != 0)
                 return -1;
+            o->has_texture = 1;
         } else if (is_id(t, "finish")) {
             if (parse_finish(p, &o->finish) != 0)
                 return -1;
+            o->has_texture = 1;
         } else if (is_id(t, "texture")) {
             if (parse_texture(p, &o->pigment, &pat, &o->finish) != 0)
                 return -1;
+            o->has_texture = 1;
+        } else if (is_id(t, "interior")) {
+            if (parse_interior(p, &o->ior) != 0)
+                return -1;
+        } else if (is_id(t, "inverse")) {
+            take(p);
+            o->inverse = !o->inverse;
         } else if (transform_kind(t) != XF_NONE) {
             rs_transform step;
             rs_token kw;
@@ -1130,7 +1606,8 @@ static int parse_object_modifiers(parser *p, rs_object *o)
                 return -1;
         } else {
             snprintf(what, sizeof what,
-                     "pigment, finish, texture, translate, rotate, scale or '}' in %s", name);
+                     "pigment, finish, texture, interior, inverse, translate, rotate, scale or "
+                     "'}' in %s", name);
             return expected(p, t, what);
         }
     }
@@ -1240,19 +1717,11 @@ static double xf_scale_factor(const rs_transform *xf)
 /* A lens radius: a float, or inf / -inf / +inf (flat). */
 static int parse_lens_radius(parser *p, const char *what, double *out)
 {
-    const rs_token *t = peek(p);
-    if (is_id(t, "inf")) {
-        take(p);
-        *out = INFINITY;
-        return 0;
-    }
-    if ((is_punct(t, '-') || is_punct(t, '+')) && is_id(peek_k(p, 1), "inf")) {
-        int neg = take(p).punct == '-';
-        take(p);
-        *out = neg ? -INFINITY : INFINITY;
-        return 0;
-    }
-    return parse_float(p, what, out);
+    int rc;
+    p->allow_inf = 1;
+    rc = parse_float(p, what, out);
+    p->allow_inf = 0;
+    return rc;
 }
 
 static int parse_positive(parser *p, const char *what, double *out)
@@ -1564,14 +2033,83 @@ static int parse_polarizer(parser *p, rs_object *o, const rs_token *kw)
     return close_block(p, "polarizer");
 }
 
-static int parse_object(parser *p, rs_object_type type)
+/* cylinder { BASE, CAP, R [open] ... } and cone { BASE, R1, CAP, R2 [open]
+ * ... }: one reader, the cone reading a radius after each point. */
+static int parse_round(parser *p, rs_object *o, int cone)
+{
+    const char *name = cone ? "cone" : "cylinder";
+    rs_token start, rtok;
+    lp_vec3 a, b;
+    double r1 = 0.0, r2;
+    int open = 0;
+    if (open_block(p, name) != 0 || parse_vector(p, &a) != 0)
+        return -1;
+    skip_comma(p);
+    rtok = *peek(p);
+    if (cone) {
+        if (parse_float(p, "the cone's base radius", &r1) != 0)
+            return -1;
+        skip_comma(p);
+    }
+    start = *peek(p);
+    if (parse_vector(p, &b) != 0)
+        return -1;
+    if (a.x == b.x && a.y == b.y && a.z == b.z)
+        return error_at(p, start.line, start.column, "the %s's base and cap points must differ",
+                        name);
+    skip_comma(p);
+    if (!cone)
+        rtok = *peek(p);
+    if (parse_float(p, cone ? "the cone's cap radius" : "the cylinder radius", &r2) != 0)
+        return -1;
+    if (cone && (!(r1 >= 0.0) || !(r2 >= 0.0) || !(r1 > 0.0 || r2 > 0.0)))
+        return error_at(p, rtok.line, rtok.column,
+                        "the cone's radii must be at least 0, and one of them positive");
+    if (!cone && !(r2 > 0.0))
+        return error_at(p, rtok.line, rtok.column, "the cylinder radius must be positive");
+    if (is_id(peek(p), "open")) {
+        take(p);
+        open = 1;
+    }
+    if (cone) {
+        o->u.cone.base = a;
+        o->u.cone.cap = b;
+        o->u.cone.base_radius = r1;
+        o->u.cone.cap_radius = r2;
+        o->u.cone.open = open;
+    } else {
+        o->u.cylinder.base = a;
+        o->u.cylinder.cap = b;
+        o->u.cylinder.radius = r2;
+        o->u.cylinder.open = open;
+    }
+    return parse_object_modifiers(p, o);
+}
+
+/* torus { MAJOR, MINOR ... }: about the y axis. */
+static int parse_torus(parser *p, rs_object *o, const rs_token *kw)
+{
+    rs_token start;
+    if (open_block(p, "torus") != 0)
+        return -1;
+    start = *peek(p);
+    if (parse_float(p, "the torus major radius", &o->u.torus.major) != 0)
+        return -1;
+    skip_comma(p);
+    if (parse_float(p, "the torus minor radius", &o->u.torus.minor) != 0)
+        return -1;
+    if (!(o->u.torus.major > 0.0 && o->u.torus.minor > 0.0))
+        return error_at(p, start.line, start.column, "the torus radii must be positive");
+    (void)kw;
+    return parse_object_modifiers(p, o);
+}
+
+static int parse_primitive(parser *p, rs_object_type type, rs_group *g)
 {
     rs_token kw = take(p);
     rs_object o;
     int rc;
 
-    if (check_room(p, p->scene->n_objects, &kw, "objects") != 0)
-        return -1;
     object_init(&o, type, p, &kw);
     switch (type) {
     case RS_OBJ_PLANE: rc = parse_plane(p, &o); break;
@@ -1579,11 +2117,272 @@ static int parse_object(parser *p, rs_object_type type)
     case RS_OBJ_BOX: rc = parse_box(p, &o); break;
     case RS_OBJ_DISC: rc = parse_disc(p, &o); break;
     case RS_OBJ_LENS: rc = parse_lens(p, &o, &kw); break;
+    case RS_OBJ_CYLINDER: rc = parse_round(p, &o, 0); break;
+    case RS_OBJ_CONE: rc = parse_round(p, &o, 1); break;
+    case RS_OBJ_TORUS: rc = parse_torus(p, &o, &kw); break;
     default: rc = parse_polarizer(p, &o, &kw); break;
     }
     if (rc != 0)
         return -1;
-    return push_object(p, &o, &kw);
+    if (check_room(p, g->n_objects, &kw, "objects") != 0)
+        return -1;
+    if (rs__group_push_object(g, &o) != 0)
+        return error_at(p, kw.line, kw.column, "out of memory");
+    return 0;
+}
+
+/* Is xf a similarity (the same scale k on every axis)?  *k gets it. */
+static int similarity(const rs_transform *xf, double *k)
+{
+    double c[3][3], n[3], hi = 0.0, lo = INFINITY;
+    for (int j = 0; j < 3; j++) {
+        for (int i = 0; i < 3; i++)
+            c[j][i] = xf->m[i][j];
+        n[j] = vec_length((lp_vec3){ c[j][0], c[j][1], c[j][2] });
+        hi = fmax(hi, n[j]);
+        lo = fmin(lo, n[j]);
+    }
+    if (!(hi > 0.0) || hi - lo > 1e-9 * hi)
+        return 0;
+    for (int a = 0; a < 3; a++)
+        for (int b = a + 1; b < 3; b++)
+            if (fabs(c[a][0] * c[b][0] + c[a][1] * c[b][1] + c[a][2] * c[b][2]) > 1e-9 * hi * hi)
+                return 0;
+    *k = hi;
+    return 1;
+}
+
+/* Move an already built object by T (object { NAME transforms }, a union's
+ * transforms): its placement and its pattern. */
+static int transform_object(parser *p, const rs_token *kw, rs_object *o, const rs_transform *T)
+{
+    rs_transform inv;
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++) {
+            inv.m[i][j] = T->inv_m[i][j];
+            inv.inv_m[i][j] = T->m[i][j];
+        }
+        inv.t[i] = T->inv_t[i];
+        inv.inv_t[i] = T->t[i];
+    }
+    rs_transform_compose(&inv, &o->pigment.to_pattern, &o->pigment.to_pattern);
+    if (!xf_finite(&o->pigment.to_pattern))
+        return error_at(p, kw->line, kw->column,
+                        "the transforms are too large: a value is not finite");
+    if (o->type == RS_OBJ_LENS || o->type == RS_OBJ_POLARIZER) {
+        double k, dot;
+        const char *what = o->type == RS_OBJ_LENS ? "lens" : "polarizer";
+        if (!similarity(T, &k))
+            return error_at(p, kw->line, kw->column,
+                            "a %s can only be moved, turned and scaled by the same factor on "
+                            "every axis", what);
+        if (o->type == RS_OBJ_LENS) {
+            lp_lens_desc *d = &o->u.lens.desc;
+            lp_vec3 ax = rs_xf_dir(T, d->axis);
+            d->radius1 *= k;
+            d->radius2 *= k;
+            d->thickness *= k;
+            d->diameter *= k;
+            d->diameter2 *= k;
+            d->position = rs_xf_point(T, d->position);
+            d->axis = (lp_vec3){ ax.x / k, ax.y / k, ax.z / k };
+            if (!vec_finite(d->position) || !isfinite(d->thickness) ||
+                !isfinite(d->diameter) || !isfinite(d->diameter2) || !(d->thickness > 0.0))
+                return error_at(p, kw->line, kw->column,
+                                "lens: a value is not finite after the transforms");
+        } else {
+            lp_vec3 n, a;
+            if (!normalize(rs_xf_dir(T, o->u.polarizer.normal), &n) ||
+                !normalize(rs_xf_dir(T, o->u.polarizer.axis), &a))
+                return error_at(p, kw->line, kw->column,
+                                "polarizer: a value is not finite after the transforms");
+            dot = a.x * n.x + a.y * n.y + a.z * n.z;
+            a = (lp_vec3){ a.x - dot * n.x, a.y - dot * n.y, a.z - dot * n.z };
+            if (!normalize(a, &a))
+                return error_at(p, kw->line, kw->column, "polarizer: the axis vanishes");
+            o->u.polarizer.center = rs_xf_point(T, o->u.polarizer.center);
+            o->u.polarizer.normal = n;
+            o->u.polarizer.axis = a;
+            o->u.polarizer.radius *= k;
+            if (!vec_finite(o->u.polarizer.center) || !(o->u.polarizer.radius > 0.0) ||
+                !isfinite(o->u.polarizer.radius))
+                return error_at(p, kw->line, kw->column,
+                                "polarizer: a value is not finite after the transforms");
+        }
+        return 0;
+    }
+    return apply_step(p, kw, &o->xf, T);
+}
+
+static int transform_light(parser *p, const rs_token *kw, rs_light *l, const rs_transform *T)
+{
+    l->position = rs_xf_point(T, l->position);
+    if (!vec_finite(l->position))
+        return error_at(p, kw->line, kw->column,
+                        "light_source: the position is not finite after the transforms");
+    if (l->polarized && !normalize(rs_xf_dir(T, l->polarization), &l->polarization))
+        return error_at(p, kw->line, kw->column,
+                        "light_source: the polarization vanishes after the transforms");
+    return 0;
+}
+
+static int parse_object_statement(parser *p, rs_group *g);
+static int is_object_start(parser *p, const rs_token *t);
+
+/* The modifiers of object { NAME ... } and of union/merge: transforms move
+ * everything; a pigment, finish or texture goes to every member without one
+ * of its own (to the member itself when there is just one). */
+static int parse_group_modifiers(parser *p, rs_group *g, int children, const char *name)
+{
+    char what[160];
+    for (;;) {
+        const rs_token *t = peek(p);
+        if (is_punct(t, '}'))
+            return close_block(p, name);
+        if (children && is_object_start(p, t)) {
+            if (parse_object_statement(p, g) != 0)
+                return -1;
+        } else if (transform_kind(t) != XF_NONE) {
+            rs_transform step;
+            rs_token kw;
+            lp_vec3 v;
+            if (parse_transform_step(p, &step, &v, &kw) != 0)
+                return -1;
+            for (size_t i = 0; i < g->n_objects; i++)
+                if (transform_object(p, &kw, &g->objects[i], &step) != 0)
+                    return -1;
+            for (size_t i = 0; i < g->n_lights; i++)
+                if (transform_light(p, &kw, &g->lights[i], &step) != 0)
+                    return -1;
+        } else if (is_id(t, "pigment") || is_id(t, "finish") || is_id(t, "texture")) {
+            int one = g->n_objects == 1;
+            rs_pigment pig;
+            rs_finish fin;
+            rs_transform pat;
+            int is_pig = is_id(t, "pigment"), is_fin = is_id(t, "finish");
+            default_pigment(&pig);
+            default_finish(&fin);
+            rs_transform_identity(&pat);
+            if (one) {
+                const rs_transform *tp = &g->objects[0].pigment.to_pattern;
+                pig = g->objects[0].pigment;
+                fin = g->objects[0].finish;
+                for (int i = 0; i < 3; i++) {
+                    for (int j = 0; j < 3; j++) {
+                        pat.m[i][j] = tp->inv_m[i][j];
+                        pat.inv_m[i][j] = tp->m[i][j];
+                    }
+                    pat.t[i] = tp->inv_t[i];
+                    pat.inv_t[i] = tp->t[i];
+                }
+            }
+            if (is_pig ? parse_pigment(p, &pig, &pat)
+                       : is_fin ? parse_finish(p, &fin) : parse_texture(p, &pig, &pat, &fin))
+                return -1;
+            for (int i = 0; i < 3; i++) {
+                for (int j = 0; j < 3; j++) {
+                    pig.to_pattern.m[i][j] = pat.inv_m[i][j];
+                    pig.to_pattern.inv_m[i][j] = pat.m[i][j];
+                }
+                pig.to_pattern.t[i] = pat.inv_t[i];
+                pig.to_pattern.inv_t[i] = pat.t[i];
+            }
+            for (size_t i = 0; i < g->n_objects; i++) {
+                rs_object *o = &g->objects[i];
+                if (!one && o->has_texture)
+                    continue;
+                if (!is_fin)
+                    o->pigment = pig;
+                if (!is_pig)
+                    o->finish = fin;
+                o->has_texture = 1;
+            }
+        } else if (is_id(t, "interior")) {
+            double ior = 1.0;
+            if (parse_interior(p, &ior) != 0)
+                return -1;
+            for (size_t i = 0; i < g->n_objects; i++)
+                g->objects[i].ior = ior;
+        } else {
+            snprintf(what, sizeof what, "%spigment, finish, texture, interior, translate, "
+                                        "rotate, scale or '}' in %s",
+                     children ? "an object, " : "", name);
+            return expected(p, t, what);
+        }
+    }
+}
+
+/* object { NAME modifiers } */
+static int parse_object_ref(parser *p, rs_group *g)
+{
+    rs_token kw = take(p);
+    const rs_token *t;
+    sym *s;
+    rs_group mine;
+    int rc;
+
+    if (open_block(p, "object") != 0)
+        return -1;
+    t = peek(p);
+    if (is_object_start(p, t) && !(t->kind == RS_TOK_IDENT && (s = declared(p, VAL_OBJECT)))) {
+        memset(&mine, 0, sizeof mine);
+        if (parse_object_statement(p, &mine) != 0) {
+            rs__group_free(&mine);
+            return -1;
+        }
+    } else {
+        if (t->kind != RS_TOK_IDENT)
+            return expected(p, t, "a declared object's name in 'object'");
+        s = rs__sym_find(p, t->text, t->len);
+        if (s == NULL) {
+            int n = t->len > 48 ? 48 : (int)t->len;
+            return error_at(p, t->line, t->column, "undeclared identifier '%.*s'", n, t->text);
+        }
+        if (s->v.kind != VAL_OBJECT)
+            return error_at(p, t->line, t->column, "'%.*s' is %s, not an object",
+                            (int)(t->len > 48 ? 48 : t->len), t->text, kind_name(s->v.kind));
+        memset(&mine, 0, sizeof mine);
+        if (rs__group_append(&mine, s->v.ptr) != 0) {
+            rs__group_free(&mine);
+            return error_at(p, t->line, t->column, "out of memory");
+        }
+        take(p);
+    }
+    rc = parse_group_modifiers(p, &mine, 0, "object");
+    if (rc == 0 && check_room(p, g->n_objects + mine.n_objects, &kw, "objects") != 0)
+        rc = -1;
+    if (rc == 0 && rs__group_append(g, &mine) != 0)
+        rc = error_at(p, kw.line, kw.column, "out of memory");
+    rs__group_free(&mine);
+    return rc;
+}
+
+/* union / merge { objects modifiers }: opaque objects look the same merged
+ * or not, so the members are kept as separate objects. */
+static int parse_union(parser *p, rs_group *g)
+{
+    rs_token kw = take(p);
+    char name[16];
+    rs_group mine;
+    int rc;
+
+    snprintf(name, sizeof name, "%.*s", (int)kw.len, kw.text);
+    if (open_block(p, name) != 0)
+        return -1;
+    memset(&mine, 0, sizeof mine);
+    rc = parse_group_modifiers(p, &mine, 1, name);
+    for (size_t i = 0; rc == 0 && i < mine.n_objects; i++)
+        if (mine.objects[i].type == RS_OBJ_LENS || mine.objects[i].type == RS_OBJ_POLARIZER)
+            rc = error_at(p, mine.objects[i].loc.line, mine.objects[i].loc.column,
+                          "a %s cannot be part of a %s: write it on its own (it is one "
+                          "primitive with its own caps and rim)",
+                          type_names[mine.objects[i].type], name);
+    if (rc == 0 && check_room(p, g->n_objects + mine.n_objects, &kw, "objects") != 0)
+        rc = -1;
+    if (rc == 0 && rs__group_append(g, &mine) != 0)
+        rc = error_at(p, kw.line, kw.column, "out of memory");
+    rs__group_free(&mine);
+    return rc;
 }
 
 /* ------------------------------------------------------------------ */
@@ -1592,10 +2391,11 @@ static int parse_object(parser *p, rs_object_type type)
 
 static int parse_camera(parser *p)
 {
-    static const char *const other_types[] = { "orthographic", "fisheye", "ultra_wide_angle",
+    static const char *const other_types[] = { "fisheye", "ultra_wide_angle",
                                                "omnimax", "panoramic", "cylinder",
                                                "spherical" };
     rs_camera *c = &p->scene->camera;
+    rs_token angle_tok = { RS_TOK_EOF, 0, 0, 0, 0, NULL, 0 };
     take(p);
     if (open_block(p, "camera") != 0)
         return -1;
@@ -1607,15 +2407,16 @@ static int parse_camera(parser *p)
         for (size_t i = 0; i < sizeof other_types / sizeof other_types[0]; i++)
             if (is_id(t, other_types[i]))
                 return error_at(p, t->line, t->column,
-                                "only the perspective camera is supported, found '%s'",
-                                other_types[i]);
-        if (is_id(t, "perspective")) {
+                                "only the perspective and orthographic cameras are supported, "
+                                "found '%s'", other_types[i]);
+        if (is_id(t, "perspective") || is_id(t, "orthographic")) {
+            c->orthographic = is_id(t, "orthographic");
             take(p);
             continue;
         }
         if (is_id(t, "angle")) {
             rs_token start;
-            take(p);
+            angle_tok = take(p);
             start = *peek(p);
             if (parse_float(p, "the camera angle", &c->angle) != 0)
                 return -1;
@@ -1670,8 +2471,8 @@ static int parse_camera(parser *p)
         else if (is_id(t, "sky"))
             target = &c->sky;
         if (target == NULL)
-            return expected(p, t, "perspective, location, look_at, angle, right, up, "
-                                  "direction, sky, focal_point, aperture, blur_samples, "
+            return expected(p, t, "perspective, orthographic, location, look_at, angle, right, "
+                                  "up, direction, sky, focal_point, aperture, blur_samples, "
                                   "translate, rotate, scale or '}' in camera");
         if (target == &c->look_at)
             c->has_look_at = 1;
@@ -1679,6 +2480,10 @@ static int parse_camera(parser *p)
         if (parse_vector(p, target) != 0)
             return -1;
     }
+    if (c->orthographic && c->has_angle)
+        return error_at(p, angle_tok.line, angle_tok.column,
+                        "angle with an orthographic camera is not supported: give right and "
+                        "up the size of the view");
     return close_block(p, "camera");
 }
 
@@ -1746,6 +2551,8 @@ static int parse_spectrum(parser *p, rs_light *l)
 static int push_light(parser *p, const rs_light *l, const rs_token *kw)
 {
     rs_scene *s = p->scene;
+    if (check_room(p, s->n_lights, kw, "light sources") != 0)
+        return -1;
     if (s->n_lights == s->cap_lights) {
         size_t cap = s->cap_lights ? s->cap_lights * 2 : 4;
         rs_light *a;
@@ -1763,13 +2570,13 @@ static int push_light(parser *p, const rs_light *l, const rs_token *kw)
 
 /* light_source { V [,] COLOUR modifiers }.  Transforms move the position
  * and turn the polarization direction. */
-static int parse_light(parser *p)
+static int parse_light(parser *p, rs_group *g)
 {
     rs_token kw = take(p);
     rs_light l;
     rs_transform xf;
 
-    if (check_room(p, p->scene->n_lights, &kw, "light sources") != 0)
+    if (check_room(p, g->n_lights, &kw, "light sources") != 0)
         return -1;
     memset(&l, 0, sizeof l);
     l.loc.file = p->file;
@@ -1821,7 +2628,46 @@ static int parse_light(parser *p)
                         "light_source: the polarization is not finite (or vanishes) after "
                         "the transforms");
     l.spectrum.rgb = l.color;
-    return push_light(p, &l, &kw);
+    if (rs__group_push_light(g, &l) != 0)
+        return error_at(p, kw.line, kw.column, "out of memory");
+    return 0;
+}
+
+static int is_object_start(parser *p, const rs_token *t)
+{
+    static const char *const kws[] = { "plane", "sphere", "box", "disc", "lens", "polarizer",
+                                       "cylinder", "cone", "torus", "object", "union", "merge",
+                                       "intersection", "difference", "light_source" };
+    (void)p;
+    for (size_t i = 0; i < sizeof kws / sizeof kws[0]; i++)
+        if (is_id(t, kws[i]))
+            return 1;
+    return 0;
+}
+
+/* One object statement (or light_source) into g. */
+static int parse_object_statement(parser *p, rs_group *g)
+{
+    static const struct { const char *kw; rs_object_type type; } prims[] = {
+        { "plane", RS_OBJ_PLANE },   { "sphere", RS_OBJ_SPHERE }, { "box", RS_OBJ_BOX },
+        { "disc", RS_OBJ_DISC },     { "lens", RS_OBJ_LENS },     { "polarizer", RS_OBJ_POLARIZER },
+        { "cylinder", RS_OBJ_CYLINDER }, { "cone", RS_OBJ_CONE }, { "torus", RS_OBJ_TORUS },
+    };
+    const rs_token *t = peek(p);
+    for (size_t i = 0; i < sizeof prims / sizeof prims[0]; i++)
+        if (is_id(t, prims[i].kw))
+            return parse_primitive(p, prims[i].type, g);
+    if (is_id(t, "object"))
+        return parse_object_ref(p, g);
+    if (is_id(t, "union") || is_id(t, "merge"))
+        return parse_union(p, g);
+    if (is_id(t, "light_source"))
+        return parse_light(p, g);
+    if (is_id(t, "intersection") || is_id(t, "difference"))
+        return error_at(p, t->line, t->column,
+                        "%.*s is not supported: use union, or a lens object for glass",
+                        (int)t->len, t->text);
+    return expected(p, t, "an object");
 }
 
 static int parse_background(parser *p)
@@ -1866,9 +2712,13 @@ static int parse_global_settings(parser *p)
             if (parse_color(p, 0, &s->ambient_light) != 0)
                 return -1;
         } else if (is_id(t, "assumed_gamma")) {
-            take(p);
+            rs_token kw = take(p);
             if (parse_positive(p, "assumed_gamma", &s->assumed_gamma) != 0)
                 return -1;
+            if (s->assumed_gamma != 1.0)
+                rs__warn(p, kw.line, kw.column,
+                         "assumed_gamma %g is read but not used: colours are linear, as with "
+                         "assumed_gamma 1", s->assumed_gamma);
         } else if (is_id(t, "coherent")) {
             take(p);
             if (parse_float(p, "coherent", &f) != 0)
@@ -1883,58 +2733,103 @@ static int parse_global_settings(parser *p)
 }
 
 /* ------------------------------------------------------------------ */
-/* Directives                                                          */
+/* Declared values                                                     */
 /* ------------------------------------------------------------------ */
 
-static int parse_directive(parser *p)
+static int alloc_payload(parser *p, const rs_token *at, val *out, val_kind kind, size_t size)
 {
-    rs_token d = take(p);
-    if (name_is(d.text, d.len, "version")) {
-        double v;
-        if (parse_float(p, "#version", &v) != 0)
+    set_float(out, 0.0);
+    out->kind = kind;
+    if ((out->ptr = calloc(1, size)) == NULL)
+        return error_at(p, at->line, at->column, "out of memory");
+    return 0;
+}
+
+static int parse_value(parser *p, val *out, const char *what);
+
+/* Any value; on failure *out holds nothing to free. */
+int rs__parse_value(parser *p, val *out, const char *what)
+{
+    if (parse_value(p, out, what) != 0) {
+        rs__val_free(out);
+        return -1;
+    }
+    return 0;
+}
+
+static int parse_value(parser *p, val *out, const char *what)
+{
+    const rs_token *t = peek(p);
+    rs_token at = *t;
+    sym *s;
+
+    set_float(out, 0.0);
+    if (is_id(t, "pigment")) {
+        rs_pigment_val *pv;
+        if (alloc_payload(p, &at, out, VAL_PIGMENT, sizeof *pv) != 0)
             return -1;
-        if (is_punct(peek(p), ';'))
-            take(p);
+        pv = out->ptr;
+        default_pigment(&pv->pig);
+        rs_transform_identity(&pv->pat);
+        return parse_pigment(p, &pv->pig, &pv->pat);
+    }
+    if (is_id(t, "finish")) {
+        if (alloc_payload(p, &at, out, VAL_FINISH, sizeof(rs_finish)) != 0)
+            return -1;
+        default_finish(out->ptr);
+        return parse_finish(p, out->ptr);
+    }
+    if (is_id(t, "texture")) {
+        rs_texture_val *tv;
+        if (alloc_payload(p, &at, out, VAL_TEXTURE, sizeof *tv) != 0)
+            return -1;
+        tv = out->ptr;
+        default_pigment(&tv->pig);
+        rs_transform_identity(&tv->pat);
+        default_finish(&tv->fin);
+        return parse_texture(p, &tv->pig, &tv->pat, &tv->fin);
+    }
+    if (is_id(t, "interior")) {
+        if (alloc_payload(p, &at, out, VAL_INTERIOR, sizeof(double)) != 0)
+            return -1;
+        *(double *)out->ptr = 1.0;
+        return parse_interior(p, out->ptr);
+    }
+    if (is_object_start(p, t)) {
+        if (alloc_payload(p, &at, out, VAL_OBJECT, sizeof(rs_group)) != 0)
+            return -1;
+        return parse_object_statement(p, out->ptr);
+    }
+    if (is_id(t, "camera") || is_id(t, "background") || is_id(t, "global_settings"))
+        return error_at(p, t->line, t->column,
+                        "a %.*s cannot be declared: write it in the scene", (int)t->len,
+                        t->text);
+    if (is_color_keyword(t)) {
+        double c[5];
+        if (parse_color5(p, c) != 0)
+            return -1;
+        set_vector(out, 5);
+        for (int i = 0; i < 5; i++)
+            out->v[i] = c[i];
         return 0;
     }
-    if (name_is(d.text, d.len, "declare") || name_is(d.text, d.len, "local")) {
-        const rs_token *t = peek(p);
-        rs_token name, start;
-        val v;
-        char what[48];
-        snprintf(what, sizeof what, "an identifier after '#%.*s'", (int)d.len, d.text);
-        if (t->kind != RS_TOK_IDENT)
-            return expected(p, t, what);
-        if (is_reserved(t->text, t->len))
-            return error_at(p, t->line, t->column, "'%.*s' is a reserved word", (int)t->len,
-                            t->text);
-        name = take(p);
-        if (expect_punct(p, '=', "'=' after the identifier") != 0)
-            return -1;
-        t = peek(p);
-        start = *t;
-        if (is_color_start(p, t) && !is_expr_start(p, t)) {
-            rs_color c;
-            if (parse_color(p, 1, &c) != 0)
-                return -1;
-            v.vec = 1;
-            v.v[0] = c.r;
-            v.v[1] = c.g;
-            v.v[2] = c.b;
-        } else if (is_expr_start(p, t)) {
-            if (parse_expr(p, &v) != 0)
-                return -1;
-        } else {
-            return expected(p, &start, "a float, vector or colour value");
-        }
-        if (expect_punct(p, ';', "';' after the declared value") != 0)
-            return -1;
-        if (sym_set(p, name.text, name.len, &v) != 0)
-            return error_at(p, name.line, name.column, "out of memory");
+    if (t->kind == RS_TOK_IDENT && (s = rs__sym_find(p, t->text, t->len)) != NULL &&
+        s->v.kind != VAL_FLOAT && s->v.kind != VAL_VECTOR && s->v.kind != VAL_STRING) {
+        if (rs__val_copy(&s->v, out) != 0)
+            return error_at(p, t->line, t->column, "out of memory");
+        take(p);
         return 0;
     }
-    return error_at(p, d.line, d.column, "unsupported directive '#%.*s'",
-                    (int)(d.len > 48 ? 48 : d.len), d.text);
+    if (is_expr_start(p, t) || t->kind == RS_TOK_STRING || is_id(t, "concat") ||
+        is_id(t, "str") || is_id(t, "chr"))
+        return parse_expr(p, out);
+    if (t->kind == RS_TOK_IDENT && is_reserved(t->text, t->len)) {
+        char w[160];
+        snprintf(w, sizeof w, "%s (a float, vector, colour, string, pigment, finish, texture, "
+                              "interior or object)", what);
+        return expected(p, t, w);
+    }
+    return expected(p, t, what);
 }
 
 /* ------------------------------------------------------------------ */
@@ -1943,39 +2838,46 @@ static int parse_directive(parser *p)
 
 static int parse_scene(parser *p)
 {
-    static const struct { const char *kw; rs_object_type type; } objects[] = {
-        { "plane", RS_OBJ_PLANE }, { "sphere", RS_OBJ_SPHERE }, { "box", RS_OBJ_BOX },
-        { "disc", RS_OBJ_DISC },   { "lens", RS_OBJ_LENS },     { "polarizer", RS_OBJ_POLARIZER },
-    };
     for (;;) {
         const rs_token *t = peek(p);
         int rc = 1;
+        if (p->failed)
+            return -1;
         if (t->kind == RS_TOK_EOF)
-            return 0;
-        if (t->kind == RS_TOK_DIRECTIVE) {
-            rc = parse_directive(p);
-        } else if (is_id(t, "camera")) {
+            break;
+        if (is_id(t, "camera")) {
             rc = parse_camera(p);
-        } else if (is_id(t, "light_source")) {
-            rc = parse_light(p);
         } else if (is_id(t, "background")) {
             rc = parse_background(p);
         } else if (is_id(t, "global_settings")) {
             rc = parse_global_settings(p);
-        } else {
-            for (size_t i = 0; i < sizeof objects / sizeof objects[0]; i++) {
-                if (is_id(t, objects[i].kw)) {
-                    rc = parse_object(p, objects[i].type);
-                    break;
-                }
-            }
+        } else if (is_object_start(p, t)) {
+            rs_group g;
+            rs_token kw = *t;
+            memset(&g, 0, sizeof g);
+            rc = parse_object_statement(p, &g);
+            for (size_t i = 0; rc == 0 && i < g.n_objects; i++)
+                rc = push_object(p, &g.objects[i], &kw);
+            for (size_t i = 0; rc == 0 && i < g.n_lights; i++)
+                rc = push_light(p, &g.lights[i], &kw);
+            rs__group_free(&g);
         }
-        if (rc > 0)
-            return expected(p, t, "camera, light_source, background, global_settings, plane, "
-                                  "sphere, box, disc, lens, polarizer or a directive");
+        if (rc > 0) {
+            if (t->kind == RS_TOK_IDENT && declared(p, VAL_OBJECT) != NULL)
+                return error_at(p, t->line, t->column,
+                                "'%.*s' is a declared object: write object { %.*s }",
+                                (int)(t->len > 48 ? 48 : t->len), t->text,
+                                (int)(t->len > 48 ? 48 : t->len), t->text);
+            return expected(p, t, "camera, light_source, background, global_settings, an "
+                                  "object (plane, sphere, box, disc, cylinder, cone, torus, "
+                                  "lens, polarizer, object, union, merge) or a directive");
+        }
         if (rc < 0)
             return -1;
     }
+    if (p->scene->n_objects == 0)
+        rs__warn(p, peek(p)->line, peek(p)->column, "no objects in the scene");
+    return p->failed ? -1 : 0;
 }
 
 static void set_msg(char *msg, size_t msg_size, const char *fmt, ...)
@@ -1988,8 +2890,7 @@ static void set_msg(char *msg, size_t msg_size, const char *fmt, ...)
     }
 }
 
-/* Keep a copy of the file name in the scene for rs_loc. */
-static const char *scene_add_file(rs_scene *scene, const char *name)
+const char *rs__scene_add_file(rs_scene *scene, const char *name)
 {
     size_t n = strlen(name);
     char *copy = malloc(n + 1);
@@ -2007,10 +2908,70 @@ static const char *scene_add_file(rs_scene *scene, const char *name)
     return copy;
 }
 
+int rs__read_text(const char *path, char **out, size_t *out_len, char *why, size_t why_size)
+{
+    FILE *f;
+    char *buf = NULL;
+    size_t len = 0, cap = 0;
+
+    *out = NULL;
+    *out_len = 0;
+    f = fopen(path, "rb");
+    if (f == NULL) {
+        int e = errno;
+        set_msg(why, why_size, "cannot read: %s", strerror(e));
+        errno = e;
+        return -1;
+    }
+    for (;;) {
+        size_t got;
+        if (len + 1 >= cap) {
+            size_t ncap = cap ? cap * 2 : 65536;
+            char *nb;
+            if (ncap > MAX_SOURCE_BYTES + 2)
+                ncap = MAX_SOURCE_BYTES + 2; /* one byte more tells "too long" */
+            nb = realloc(buf, ncap);
+            if (nb == NULL) {
+                free(buf);
+                fclose(f);
+                set_msg(why, why_size, "out of memory");
+                errno = ENOMEM;
+                return -1;
+            }
+            buf = nb;
+            cap = ncap;
+        }
+        got = fread(buf + len, 1, cap - 1 - len, f);
+        len += got;
+        if (got == 0 || len > MAX_SOURCE_BYTES)
+            break; /* len > MAX: too long (/dev/zero, ...), refused below */
+    }
+    if (ferror(f)) {
+        int e = errno;
+        set_msg(why, why_size, "cannot read: %s", strerror(e));
+        free(buf);
+        fclose(f);
+        errno = e ? e : EIO;
+        return -1;
+    }
+    fclose(f);
+    if (len > MAX_SOURCE_BYTES) {
+        set_msg(why, why_size, "larger than %zu MiB", MAX_SOURCE_BYTES >> 20);
+        free(buf);
+        errno = EFBIG;
+        return -1;
+    }
+    buf[len] = '\0';
+    *out = buf;
+    *out_len = len;
+    return 0;
+}
+
 static int parse_buffer(const char *text, size_t len, const char *name,
                         const rs_parse_opts *opts, rs_scene *scene, char *msg, size_t msg_size)
 {
     parser p;
+    const char *file;
     int rc;
 
     if (len > MAX_SOURCE_BYTES) {
@@ -2022,19 +2983,34 @@ static int parse_buffer(const char *text, size_t len, const char *name,
     p.msg = msg;
     p.msg_size = msg_size;
     p.scene = scene;
-    p.file = scene_add_file(scene, name);
-    if (p.file == NULL) {
+    p.version = 3.7;
+    p.budget = RS_TOKEN_BUDGET;
+    file = rs__scene_add_file(scene, name);
+    if (file == NULL) {
         set_msg(msg, msg_size, "%s: out of memory", name);
         return -1;
     }
+    p.file = file;
     p.image_width = (opts != NULL && opts->image_width > 0) ? opts->image_width : DEFAULT_WIDTH;
     p.image_height =
         (opts != NULL && opts->image_height > 0) ? opts->image_height : DEFAULT_HEIGHT;
     p.max_objects = (opts != NULL && opts->max_objects > 0) ? opts->max_objects
                                                             : DEFAULT_MAX_OBJECTS;
-    rs_lexer_init(&p.lx, text, len);
-    rc = parse_scene(&p);
-    sym_free(&p);
+    if (opts != NULL) {
+        p.include_dirs = opts->include_dirs;
+        p.n_include_dirs = opts->n_include_dirs;
+        if (opts->max_tokens > 0)
+            p.budget = opts->max_tokens;
+        p.no_include = opts->no_include;
+    }
+    if (rs__scope_push(&p) != 0 || rs__push_file(&p, text, len, file, 1, 1) != 0) {
+        set_msg(msg, msg_size, "%s: out of memory", name);
+        rc = -1;
+    } else {
+        rc = parse_scene(&p);
+    }
+    rs__stream_free(&p);
+    rs__symbols_free(&p);
     return rc;
 }
 
@@ -2059,9 +3035,8 @@ int rs_parse_string(const char *text, const char *name, const rs_parse_opts *opt
 int rs_parse_file(const char *path, const rs_parse_opts *opts, rs_scene *scene, char *msg,
                   size_t msg_size)
 {
-    FILE *f;
-    char *buf = NULL;
-    size_t len = 0, cap = 0;
+    char *buf = NULL, why[256] = "";
+    size_t len = 0;
     int rc;
 
     set_msg(msg, msg_size, "%s", "");
@@ -2069,40 +3044,13 @@ int rs_parse_file(const char *path, const rs_parse_opts *opts, rs_scene *scene, 
         set_msg(msg, msg_size, "no file or no scene to parse into");
         return -1;
     }
-    f = fopen(path, "rb");
-    if (f == NULL) {
-        set_msg(msg, msg_size, "%s: cannot read: %s", path, strerror(errno));
+    if (rs__read_text(path, &buf, &len, why, sizeof why) != 0) {
+        if (errno == EFBIG)
+            set_msg(msg, msg_size, "%s:1:1: the scene is %s", path, why);
+        else
+            set_msg(msg, msg_size, "%s: %s", path, why);
         return -1;
     }
-    for (;;) {
-        size_t got;
-        if (len == cap) {
-            size_t ncap = cap ? cap * 2 : 65536;
-            char *nb;
-            if (ncap > MAX_SOURCE_BYTES + 1)
-                ncap = MAX_SOURCE_BYTES + 1; /* one byte more tells "too long" */
-            nb = realloc(buf, ncap);
-            if (nb == NULL) {
-                free(buf);
-                fclose(f);
-                set_msg(msg, msg_size, "%s: out of memory", path);
-                return -1;
-            }
-            buf = nb;
-            cap = ncap;
-        }
-        got = fread(buf + len, 1, cap - len, f);
-        len += got;
-        if (got == 0 || len > MAX_SOURCE_BYTES)
-            break; /* len > MAX: too long (/dev/zero, ...), refused below */
-    }
-    if (ferror(f)) {
-        set_msg(msg, msg_size, "%s: cannot read: %s", path, strerror(errno));
-        free(buf);
-        fclose(f);
-        return -1;
-    }
-    fclose(f);
     rc = parse_buffer(buf, len, path, opts, scene, msg, msg_size);
     free(buf);
     return rc;

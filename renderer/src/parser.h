@@ -14,37 +14,63 @@
  * gives "PATH: cannot read: <reason>".
  *
  * What is accepted (POV-Ray 3.7 meaning unless noted):
- *   #declare / #local NAME = float | vector | colour ;   #version F ;
- *   expressions  + - * / unary -, ( ), <a,b,c>, V.x V.y V.z V.red ...,
- *                x y z pi true false on off yes no image_width image_height,
- *                sqrt sin cos tan asin acos atan atan2 pow abs min max
- *                radians degrees exp ln log floor ceil int mod
- *                vlength vnormalize vdot vcross; a float promotes to
- *                <f,f,f> where a vector is wanted
- *   colours      [color|colour] rgb V | V | red F green F blue F (and an
- *                identifier followed by red/green/blue overrides).  rgbf,
- *                rgbt, rgbft, filter, transmit are refused; so is a lone
- *                non-zero float as a pigment colour (POV-Ray would make it
- *                transparent).
- *   camera { [perspective] location look_at angle right up direction sky
- *            translate rotate scale }            (stored as written)
+ *   directives   (directive.c) #include "F" (beside the including file,
+ *                then in include_dirs), #declare / #local NAME = VALUE [;]
+ *                of every kind below, #undef, #version F;, #if / #elseif /
+ *                #else / #end, #ifdef / #ifndef (NAME), #while (F),
+ *                #switch (F) #case (F) #range (LO, HI) #break #else,
+ *                #macro NAME (P, ...) ... #end and calls NAME (ARG, ...),
+ *                #debug / #warning / #error "TEXT"
+ *   values       float, vector (3 to 5 components), colour (5: r g b filter
+ *                transmit), string, pigment { }, finish { }, texture { },
+ *                interior { }, and objects (any object statement below,
+ *                light_source too); a float, vector or string declaration
+ *                ends with ';'
+ *   expressions  + - * / unary - + !, ( ), < > <= >= = != & | ?:, <a,b,c[,d[,e]]>,
+ *                V.x V.y V.z V.u V.v V.red V.green V.blue V.filter V.transmit
+ *                V.t, x y z pi true false on off yes no clock (0) version
+ *                image_width image_height, sqrt sin cos tan asin acos atan
+ *                atan2 pow abs min max radians degrees exp ln log floor ceil
+ *                int mod div select vlength vnormalize vdot vcross strlen;
+ *                strings "..." concat str chr; a float promotes to all
+ *                components where a vector is wanted.  '<' compares only
+ *                after a float and '>' only outside a vector literal (or in
+ *                parentheses), so "box { <0,0,0> <1,1,1> }" still reads.
+ *   colours      [color|colour] rgb V | rgbf V | rgbt V | rgbft V | V, then
+ *                red green blue filter transmit F.  A pigment must be opaque
+ *                (filter = transmit = 0): transparency is refused (a lone
+ *                float V sets filter and transmit too, as in POV-Ray).
+ *   camera { [perspective|orthographic] location look_at angle right up
+ *            direction sky translate rotate scale }  (stored as written;
+ *            angle with orthographic is refused)
  *   light_source { V [,] COLOUR [polarization V] [spectrum { blackbody T |
  *            line NM | rgb }] [coherent [on|off | L]] [translate rotate scale] }
  *            (coherent L: coherence length L mm, 0 or none = infinite)
  *   background { COLOUR }
  *   global_settings { max_trace_level N adc_bailout F ambient_light C
- *            assumed_gamma F coherent BOOL }
+ *            assumed_gamma F (a value other than 1 warns) coherent BOOL }
  *   plane { N [,] D ... }  sphere { C [,] R ... }  box { A [,] B ... }
- *   disc { C [,] N [,] R [, HOLE] ... }
- *     with pigment { COLOUR | checker [C1 [,] [C2]] + transforms },
- *     finish { ambient C diffuse F emission C; specular phong phong_size
- *              brilliance roughness reflection conserve_energy are read
- *              and ignored }, texture { pigment finish transforms },
- *     translate rotate scale
+ *   disc { C [,] N [,] R [, HOLE] ... }  cylinder { A, B, R [open] ... }
+ *   cone { A, RA, B, RB [open] ... }  torus { MAJOR, MINOR ... }
+ *   object { NAME | OBJECT  modifiers }  union / merge { objects modifiers }
+ *     (kept as separate objects; a union's texture goes to the members
+ *     without one; lenses and polarizers are refused inside; intersection
+ *     and difference are refused)
+ *     with pigment { NAME | COLOUR | checker [C1 [,] [C2]] + transforms },
+ *     finish { NAME ambient C diffuse F brilliance F emission C phong F
+ *              phong_size F specular F roughness F reflection F | C |
+ *              { [C_MIN,] C_MAX [fresnel [BOOL]] } conserve_energy;
+ *              metallic, crand and reflection's falloff, exponent and
+ *              metallic are read and warned about }, texture { NAME
+ *              pigment finish transforms }, interior { NAME ior F },
+ *     inverse, translate rotate scale
  *   lens { radius1 R radius2 R thickness T diameter D [diameter2 D2]
  *          glass "NAME" | ior N | sellmeier { B1, B2, B3, C1, C2, C3 }
  *          [medium ior N] translate rotate scale }   (R: 0 or inf = flat)
  *   polarizer { [center V] normal V radius F axis V translate rotate scale }
+ *
+ * Warnings (rs_scene.messages, "FILE:LINE:COL: warning: ..."): whatever is
+ * read but not rendered, #warning, and a scene with no objects.
  *
  * A later pigment or finish block modifies the object's current one (a new
  * colour or checker replaces the pattern and its transforms); defaults are
@@ -72,6 +98,16 @@ typedef struct rs_parse_opts {
     int image_width;     /* the value of image_width; <= 0: 640 */
     int image_height;    /* the value of image_height; <= 0: 480 */
     size_t max_objects;  /* objects (and lights) allowed; 0: 100,000 */
+    /* Where #include looks after the including file's own directory, in
+     * order (POV-Ray's Library_Path); the caller owns the strings. */
+    const char *const *include_dirs;
+    size_t n_include_dirs;
+    /* Tokens the whole parse may read, loops and macro bodies counted each
+     * time (an endless #while ends with an error); 0: 20,000,000. */
+    unsigned long long max_tokens;
+    /* Nonzero: #include is refused ("include files are off"): the scene is
+     * read from the text alone, no file is opened. */
+    int no_include;
 } rs_parse_opts;
 
 /* All zero: the defaults above. */

@@ -58,9 +58,32 @@ void rs_scene_free(rs_scene *scene)
     for (size_t i = 0; i < scene->n_files; i++)
         free(scene->files[i]);
     free(scene->files);
+    for (size_t i = 0; i < scene->n_messages; i++)
+        free(scene->messages[i].text);
+    free(scene->messages);
     lp_catalog_destroy(scene->catalog);
     rs_bvh_destroy(scene->bvh);
     rs_scene_init(scene);
+}
+
+int rs_scene_add_message(rs_scene *scene, rs_message_kind kind, const char *text)
+{
+    size_t n = strlen(text);
+    char *copy = malloc(n + 1);
+    rs_message *a;
+    if (copy == NULL)
+        return -1;
+    memcpy(copy, text, n + 1);
+    a = realloc(scene->messages, (scene->n_messages + 1) * sizeof *a);
+    if (a == NULL) {
+        free(copy);
+        return -1;
+    }
+    scene->messages = a;
+    scene->messages[scene->n_messages].kind = kind;
+    scene->messages[scene->n_messages].text = copy;
+    scene->n_messages++;
+    return 0;
 }
 
 static int prep_error(char *msg, size_t msg_size, const rs_loc *loc, const char *fmt, ...)

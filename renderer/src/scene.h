@@ -40,10 +40,29 @@ typedef struct rs_pigment {
                                object's and the pigment's own transforms */
 } rs_pigment;
 
+/* POV-Ray 3.7's finish, with its formulas (the integrator's shade()):
+ * per light of colour C seen in direction L from a point with normal N,
+ * viewed along the ray direction D (R = D - 2 (D.N) N, H = unit(L - D)):
+ *   diffuse   pigment * C * diffuse * (N.L)^brilliance        (N.L > 0)
+ *   phong     C * phong * (R.L)^phong_size                    (R.L > 0)
+ *   specular  C * specular * (N.H)^(1/roughness)              (N.H > 0)
+ * and a mirror ray along R weighted by the reflectivity: `reflection`
+ * as a colour (min = max), or { min, max [fresnel on] }: with fresnel,
+ * min + (max - min) * F(theta) where F is the unpolarized Fresnel
+ * reflectance from air into an index `ior` (the object's interior). */
 typedef struct rs_finish {
     rs_color ambient;       /* POV-Ray default 0.1 */
     double diffuse;         /* POV-Ray default 0.6 */
+    double brilliance;      /* default 1 */
     rs_color emission;      /* default 0 */
+    double phong;           /* default 0 */
+    double phong_size;      /* default 40 */
+    double specular;        /* default 0 */
+    double roughness;       /* default 0.05 */
+    rs_color reflection_min;/* default 0 */
+    rs_color reflection_max;/* default 0 */
+    int fresnel;            /* reflection { ... fresnel on } */
+    int conserve_energy;    /* read: used by lenses only (they conserve) */
 } rs_finish;
 
 /* A spectrum of an emitter.  RGB colours become spectra by the method in
@@ -68,7 +87,10 @@ typedef enum rs_object_type {
     RS_OBJ_BOX,
     RS_OBJ_DISC,
     RS_OBJ_LENS,
-    RS_OBJ_POLARIZER
+    RS_OBJ_POLARIZER,
+    RS_OBJ_CYLINDER,
+    RS_OBJ_CONE,
+    RS_OBJ_TORUS
 } rs_object_type;
 
 typedef struct rs_object {
@@ -86,12 +108,22 @@ typedef struct rs_object {
             char glass_name[LP_GLASS_NAME_MAX]; /* "" when ior/sellmeier given */
         } lens;
         struct { lp_vec3 center, normal, axis; double radius; } polarizer;
+        /* cylinder: base, cap, radius; open: no end discs */
+        struct { lp_vec3 base, cap; double radius; int open; } cylinder;
+        struct { lp_vec3 base, cap; double base_radius, cap_radius; int open; } cone;
+        /* torus about the y axis, centred at the origin */
+        struct { double major, minor; } torus;
     } u;
     rs_transform xf;        /* object -> world (identity when none);
                                lenses and polarizers have it folded into
                                their parameters already and keep identity */
     rs_pigment pigment;
     rs_finish finish;
+    double ior;             /* interior { ior } (default 1): for fresnel
+                               reflection of opaque objects */
+    int has_texture;        /* a pigment, finish or texture was given (a
+                               union passes its own to children without) */
+    int inverse;            /* inside and outside swapped */
     lp_lens *lens;          /* RS_OBJ_LENS: created by rs_scene_prepare */
 } rs_object;
 
@@ -123,6 +155,8 @@ typedef struct rs_camera {
     int has_angle;
     rs_transform xf;        /* transforms applied to the camera */
     int has_xf;
+    int orthographic;       /* rays parallel to direction, from the plane
+                               spanned by right and up through location */
     lp_vec3 focal_point;    /* default <0,0,0>: the point in focus */
     double aperture;        /* default 0: a pinhole; else the diameter of
                                the lens disk (camera.h) */
@@ -137,6 +171,18 @@ typedef struct rs_settings {
     int coherent;           /* global: same-ch rays add as amplitudes */
 } rs_settings;
 
+/* What the reader says besides errors: "FILE:LINE:COL: warning: ..." for
+ * what is read but not rendered (and #warning), or #debug's text as is. */
+typedef enum rs_message_kind {
+    RS_MSG_WARNING = 0,
+    RS_MSG_DEBUG
+} rs_message_kind;
+
+typedef struct rs_message {
+    rs_message_kind kind;
+    char *text;             /* owned */
+} rs_message;
+
 typedef struct rs_scene {
     rs_camera camera;
     rs_color background;    /* default black */
@@ -147,11 +193,16 @@ typedef struct rs_scene {
     size_t n_lights, cap_lights;
     char **files;           /* names of the files read (for rs_loc) */
     size_t n_files;
+    rs_message *messages;   /* warnings and #debug text, in order */
+    size_t n_messages;
     lp_catalog *catalog;    /* glasses for lenses */
     struct rs_bvh *bvh;     /* acceleration structure over the objects,
                                built by rs_scene_prepare (bvh.h); NULL
                                before: intersections loop over objects */
 } rs_scene;
+
+/* Append a copy of text to the scene's messages.  0, or -1 (no memory). */
+int rs_scene_add_message(rs_scene *scene, rs_message_kind kind, const char *text);
 
 /* Identity transform. */
 void rs_transform_identity(rs_transform *xf);

@@ -1,4 +1,5 @@
-/* shapes.c -- planes, spheres, boxes, discs, polarizers and lenses.
+/* shapes.c -- planes, spheres, boxes, discs, cylinders, cones, tori,
+ * polarizers and lenses (round_shapes.c has the cylinder, cone and torus).
  *
  * Plane, sphere, box and disc are intersected in object space: the world
  * ray is mapped by the inverse transform without renormalizing its
@@ -8,6 +9,7 @@
 #include <math.h>
 
 #include "bvh.h"
+#include "round_shapes.h"
 #include "shapes.h"
 
 static double dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
@@ -165,6 +167,21 @@ int rs_object_intersect(const rs_object *ob, lp_vec3 origin, lp_vec3 dir, double
             return 0;
         n_obj = ob->u.disc.normal;
         break;
+    case RS_OBJ_CYLINDER:
+        if (!rs_cone_hit(ob->u.cylinder.base, ob->u.cylinder.radius, ob->u.cylinder.cap,
+                         ob->u.cylinder.radius, ob->u.cylinder.open, o, d, t_min, t_max, &t,
+                         &n_obj))
+            return 0;
+        break;
+    case RS_OBJ_CONE:
+        if (!rs_cone_hit(ob->u.cone.base, ob->u.cone.base_radius, ob->u.cone.cap,
+                         ob->u.cone.cap_radius, ob->u.cone.open, o, d, t_min, t_max, &t, &n_obj))
+            return 0;
+        break;
+    case RS_OBJ_TORUS:
+        if (!rs_torus_hit(ob->u.torus.major, ob->u.torus.minor, o, d, t_min, t_max, &t, &n_obj))
+            return 0;
+        break;
     default:
         return 0;
     }
@@ -181,7 +198,7 @@ int rs_scene_intersect(const rs_scene *scene, lp_vec3 origin, lp_vec3 dir, doubl
 {
     int found = 0;
     rs_hit h;
-    if (scene->bvh && rs_bvh_object_count(scene->bvh) == scene->n_objects)
+    if (rs_bvh_serves(scene->bvh, scene))
         return rs_bvh_intersect(scene->bvh, scene, origin, dir, t_min, t_max, skip, hit);
     for (size_t i = 0; i < scene->n_objects; i++) {
         if ((int)i == skip)

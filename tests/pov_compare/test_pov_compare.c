@@ -12,9 +12,14 @@
  *     another size, e.g. 80x60 under valgrind, where memcheck runs the
  *     renderer 30-50x slower; every check below applies at any size): for EVERY scene, report.json parses and holds every
  *     key of the contract; the lens silhouettes agree (IoU >= 0.999,
- *     largest boundary displacement <= 1 px); and where POV-Ray can
- *     express the scene (no polarizer notes) our fresnel render matches
- *     POV-Ray's to PSNR >= 40 dB.
+ *     largest boundary displacement <= 1 px); and our fresnel render
+ *     matches POV-Ray's to the scene's own bar (psnr_bars below: a few dB
+ *     under what the scene measures at 320 x 240, never under 40 dB where
+ *     POV-Ray can express the scene), so that a regression in one scene
+ *     fails instead of passing a blanket 40 dB (a 40 mm band of missing rim
+ *     shadow still scores 42.5 dB).  At another size the blanket 40 dB
+ *     applies (the bars were measured at 320 x 240).  A scene without a bar
+ *     fails: measure it and add one.
  *
  * Without povray on PATH the test is skipped (exit 77). */
 #define _POSIX_C_SOURCE 200809L
@@ -46,6 +51,43 @@
 #define MIN_IOU 0.999
 #define MAX_BOUNDARY_PX 1.0
 #define MIN_PSNR_DB 40.0
+
+/* Each scene's bar for fresnel vs POV-Ray at 320 x 240, dB, with what it
+ * measured (pov_compare --all, 320 x 240).  The lens scenes without lights
+ * agree to the 16-bit quantization (~103 dB); the POV-Ray-style scenes with
+ * lights, highlights and mirrors are limited by our spectral colours
+ * against POV-Ray's RGB (their rgb mode agrees to ~100 dB); the polarizer
+ * scenes cannot be expressed in POV-Ray (a polarizer note), so their bar
+ * only catches a change. */
+static const struct {
+    const char *scene;
+    double min_db;
+} psnr_bars[] = {
+    {"biconcave.scene", 95.0},          /* 102.99 */
+    {"conoscope.scene", 1.0},           /* 3.26: a crystal between crossed polarizers, neither in POV-Ray: geometry only */
+    {"conical_rim.scene", 95.0},        /* 103.20 */
+    {"crossed_polarizers.scene", 20.0}, /* 27.36 (polarizers) */
+    {"default.scene", 95.0},            /* 102.96 */
+    {"desk_lamp.scene", 50.0},          /* 58.72 */
+    {"dispersion.scene", 108.0},        /* 115.94 */
+    {"meniscus.scene", 95.0},           /* 102.88 */
+    {"michel_levy.scene", 1.0},         /* 2.60: crystal plates between crossed polarizers, neither in POV-Ray: geometry only */
+    {"mirror_ball.scene", 64.0},        /* 71.95 */
+    {"newtons_rings.scene", 52.0},      /* 59.65 */
+    {"plan_view.scene", 64.0},          /* 71.96 */
+    {"plano_convex.scene", 95.0},       /* 102.77 */
+    {"polariscope.scene", 100.0},       /* inf: identical after clipping (polarizers) */
+};
+
+/* The bar of a scene: its own at 320 x 240, 40 dB at other sizes (or none
+ * for polarizer scenes there); -1 when the scene has no bar. */
+static double psnr_bar(const char *file, int polarizers, int default_size)
+{
+    for (size_t k = 0; k < sizeof psnr_bars / sizeof *psnr_bars; k++)
+        if (strcmp(psnr_bars[k].scene, file) == 0)
+            return default_size ? psnr_bars[k].min_db : polarizers ? 0.0 : MIN_PSNR_DB;
+    return -1.0;
+}
 
 /* The image size of the --all run: 320 x 240, or LP_POV_COMPARE_SIZE. */
 static int size_w = 320, size_h = 240;
@@ -488,11 +530,12 @@ static void check_scene(const char *file)
     CHECK(iou >= MIN_IOU, "%s: silhouette IoU %.6f < %g", file, iou, MIN_IOU);
     CHECK(bd <= MAX_BOUNDARY_PX, "%s: largest boundary displacement %.3g px > %g", file, bd,
           MAX_BOUNDARY_PX);
-    if (!polarizers)
-        CHECK(psnr >= MIN_PSNR_DB, "%s: fresnel vs POV-Ray PSNR %.2f dB < %g (see %s/report.md)",
-              file, psnr, MIN_PSNR_DB, dir);
+    double bar = psnr_bar(file, polarizers, size_w == 320 && size_h == 240);
+    CHECK(bar >= 0.0, "%s: no PSNR bar in psnr_bars: measure the scene and add one", file);
+    CHECK(psnr >= bar, "%s: fresnel vs POV-Ray PSNR %.2f dB < %g (see %s/report.md)", file, psnr,
+          bar, dir);
     printf("%-24s IoU %.6f  boundary %.3g px  fresnel vs POV-Ray %6.2f dB SSIM %.5f%s\n", file,
-           iou, bd, psnr, ssim, polarizers ? "  (polarizers: PSNR not checked)" : "");
+           iou, bd, psnr, ssim, polarizers ? "  (polarizers: POV-Ray cannot show them)" : "");
     jv_free(&root);
 }
 

@@ -52,6 +52,7 @@
 
 #include "camera.h"
 #include "check.h"
+#include "library_path.h"
 #include "support/image.h"
 #include "parser.h"
 #include "scene.h"
@@ -67,10 +68,13 @@
 static int load(rs_scene *s, const char *path, const char *text, int w, int h)
 {
     rs_parse_opts po;
+    const char *dirs[4];
     char msg[512];
     rs_parse_opts_init(&po);
     po.image_width = w;
     po.image_height = h;
+    po.include_dirs = dirs;
+    po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
     rs_scene_init(s);
     int rc = text ? rs_parse_string(text, path, &po, s, msg, sizeof msg)
                   : rs_parse_file(path, &po, s, msg, sizeof msg);
@@ -189,14 +193,19 @@ static void check_scene_file(const char *name)
     CHECK(strstr(t, "adc_bailout 0\n") != NULL, "%s: adc_bailout 0", name);
     snprintf(want, sizeof want, "max_trace_level %d\n", s.settings.max_trace_level);
     CHECK(strstr(t, want) != NULL, "%s: %s", name, want);
-    CHECK(strstr(t, "perspective") != NULL, "%s: perspective camera", name);
+    CHECK(strstr(t, s.camera.orthographic ? "orthographic" : "perspective") != NULL,
+          "%s: the camera's projection", name);
     CHECK(count(t, "Lens(") == nl, "%s: %zu Lens( calls for %zu lenses", name, count(t, "Lens("), nl);
     if (nl > 0) {
         CHECK(strstr(t, "#include \"" LENS_INC "\"") != NULL, "%s: #include of lens.inc", name);
         CHECK(strstr(t, "pigment { rgbf 1 }") != NULL, "%s: clear glass", name);
         CHECK(strstr(t, "reflection { 0, 1 fresnel on } conserve_energy") != NULL,
               "%s: Fresnel reflection with conserve_energy", name);
-        CHECK(count(t, "interior { ior ") == nl, "%s: one interior per lens", name);
+        size_t nf = 0; /* opaque objects with fresnel reflection carry their ior */
+        for (size_t i = 0; i < s.n_objects; i++)
+            nf += s.objects[i].type != RS_OBJ_LENS && s.objects[i].finish.fresnel;
+        CHECK(count(t, "interior { ior ") == nl + nf,
+              "%s: one interior per lens and per fresnel-reflecting object", name);
     }
     CHECK(strstr(t, "shadowless") == NULL, "%s: no shadowless", name);
     CHECK(strstr(t, "polarizer {") == NULL, "%s: no polarizer objects written", name);

@@ -1,14 +1,16 @@
 /* test_bvh.c -- the bounding volume hierarchy finds exactly what a loop
  * over every object finds.
  *
- *   a. Scenes of spheres, boxes, discs, lenses, polarizers and planes,
- *      scaled, rotated and translated at random (a fixed seed), and with
- *      coincident objects (the same sphere twice, touching spheres, a lens
+ *   a. Scenes of spheres, boxes, discs, cylinders, cones, tori, lenses,
+ *      polarizers and planes, scaled, rotated and translated at random (a
+ *      fixed seed), and with coincident objects (the same sphere twice, touching spheres, a lens
  *      on a plane): for random rays, from outside and from points on
  *      objects, the nearest hit of rs_scene_intersect (through the tree)
  *      is the one the loop below finds with rs_object_intersect object by
  *      object: the same object (ties go to the lower index), the same t,
- *      point and normal, bit for bit; with a skipped object too.
+ *      point and normal, bit for bit; with a skipped object too; and so
+ *      is rs_bvh_intersect's, also in the small scenes where
+ *      rs_scene_intersect keeps the loop.
  *   b. rs_bvh_any visits every object whose segment hit the loop finds
  *      (an occluder is never missed): for each ray and t_max, the set of
  *      objects the loop hits within (t_min, t_max) is a subset of the
@@ -82,7 +84,7 @@ static char *random_scene(int n)
     for (int i = 0; i < n; i++) {
         double x = range(-20, 20), y = range(-20, 20), z = range(-20, 20);
         double rx = range(0, 360), ry = range(0, 360), rz = range(0, 360);
-        int kind = i % 6;
+        int kind = i % 9;
         const char *xf = "";
         char buf[160];
         snprintf(buf, sizeof buf, "scale <%g,%g,%g> rotate <%g,%g,%g> translate <%g,%g,%g>",
@@ -112,6 +114,24 @@ static char *random_scene(int n)
                                     "polarizer { center <%g,%g,%g> normal <%g,%g,1> radius %g "
                                     "axis <1,0,0> }\n",
                                     x, y, z, range(-1, 1), range(-1, 1), range(0.5, 3));
+        else if (kind == 6)
+            len += (size_t)snprintf(s + len, cap - len,
+                                    "cylinder { <%g,%g,%g>, <%g,%g,%g>, %g %s pigment { rgb 1 } "
+                                    "%s }\n",
+                                    range(-1, 1), range(-2, -1), range(-1, 1), range(-1, 1),
+                                    range(1, 2), range(-1, 1), range(0.2, 1.5),
+                                    uni() < 0.5 ? "open" : "", xf);
+        else if (kind == 7)
+            len += (size_t)snprintf(s + len, cap - len,
+                                    "cone { <%g,%g,%g>, %g, <%g,%g,%g>, %g %s pigment { rgb 1 } "
+                                    "%s }\n",
+                                    range(-1, 1), range(-2, -1), range(-1, 1), range(0, 1.5),
+                                    range(-1, 1), range(1, 2), range(-1, 1), range(0.2, 1.5),
+                                    uni() < 0.5 ? "open" : "", xf);
+        else if (kind == 8)
+            len += (size_t)snprintf(s + len, cap - len,
+                                    "torus { %g, %g pigment { rgb 1 } %s }\n", range(1, 2),
+                                    range(0.2, 0.8), xf);
         else /* the previous sphere again, and one touching it */
             len += (size_t)snprintf(s + len, cap - len,
                                     "sphere { <%g,%g,%g>, 1 pigment { rgb 1 } }\n"
@@ -168,13 +188,22 @@ static void check_rays(const rs_scene *sc, int n_rays, const char *what)
         int fb = loop_intersect(sc, o, d, 0.0, INFINITY, skip, &b);
         if (fa != fb || (fa && !same_hit(&a, &b)))
             mismatches++;
+        /* the tree itself, also where rs_scene_intersect keeps the loop */
+        fa = rs_bvh_intersect(sc->bvh, sc, o, d, 0.0, INFINITY, skip, &a);
+        if (fa != fb || (fa && !same_hit(&a, &b)))
+            mismatches++;
         hits += fb;
         /* From the hit point on, as secondary rays start. */
         if (fb && k % 2 == 0) {
             lp_vec3 o2 = b.point, d2 = unit((lp_vec3){range(-1, 1), range(-1, 1), range(-1, 1)});
+            rs_hit c;
+            memset(&c, 0, sizeof c);
             fa = rs_scene_intersect(sc, o2, d2, 1e-9, INFINITY, b.object, &a);
+            int fc = rs_bvh_intersect(sc->bvh, sc, o2, d2, 1e-9, INFINITY, b.object, &c);
             int fb2 = loop_intersect(sc, o2, d2, 1e-9, INFINITY, b.object, &b);
             if (fa != fb2 || (fa && !same_hit(&a, &b)))
+                mismatches++;
+            if (fc != fb2 || (fc && !same_hit(&c, &b)))
                 mismatches++;
         }
         /* Every object the segment meets is visited by rs_bvh_any. */
@@ -214,6 +243,11 @@ int main(void)
             CHECK(rs_bvh_unbounded_count(sc.bvh) == 2, "%s: %zu unbounded objects, want the 2 planes",
                   what, rs_bvh_unbounded_count(sc.bvh));
             check_rays(&sc, 4000, what);
+            /* the loop below RS_BVH_MIN_BOUNDED bounded objects, the tree
+             * from there on */
+            int want = sc.n_objects - rs_bvh_unbounded_count(sc.bvh) >= RS_BVH_MIN_BOUNDED;
+            CHECK(rs_bvh_serves(sc.bvh, &sc) == want, "%s: rs_bvh_serves %d, want %d", what,
+                  rs_bvh_serves(sc.bvh, &sc), want);
         }
         rs_scene_free(&sc);
         free(text);

@@ -41,6 +41,7 @@
 #include "test_files.h"
 
 #include "args.h"
+#include "library_path.h"
 #include "parser.h"
 #include "scene.h"
 
@@ -138,6 +139,19 @@ static int scene_ok(const rs_scene *s, char *why, size_t n)
                  unit(o->u.polarizer.axis) && isfinite(o->u.polarizer.radius) &&
                  o->u.polarizer.radius > 0.0;
             break;
+        case RS_OBJ_CYLINDER:
+            ok = fin(o->u.cylinder.base) && fin(o->u.cylinder.cap) &&
+                 o->u.cylinder.radius > 0.0 && isfinite(o->u.cylinder.radius);
+            break;
+        case RS_OBJ_CONE:
+            ok = fin(o->u.cone.base) && fin(o->u.cone.cap) && o->u.cone.base_radius >= 0.0 &&
+                 o->u.cone.cap_radius >= 0.0 && isfinite(o->u.cone.base_radius) &&
+                 isfinite(o->u.cone.cap_radius);
+            break;
+        case RS_OBJ_TORUS:
+            ok = o->u.torus.major > 0.0 && o->u.torus.minor > 0.0 &&
+                 isfinite(o->u.torus.major) && isfinite(o->u.torus.minor);
+            break;
         }
         if (!ok) {
             snprintf(why, n, "object %zu (line %d) has a non-finite, zero or non-unit value", i,
@@ -175,8 +189,15 @@ static int parse_checked(const char *text, size_t len, const char *name, const c
     char msg[512], why[160];
     int rc;
 
+    rs_parse_opts opts;
+    const char *dirs[4];
+
+    /* the library path lensrender uses (POV-Ray's colors.inc ...) */
+    rs_parse_opts_init(&opts);
+    opts.include_dirs = dirs;
+    opts.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
     rs_scene_init(&scene);
-    rc = rs_parse_string(text, name, NULL, &scene, msg, sizeof msg);
+    rc = rs_parse_string(text, name, &opts, &scene, msg, sizeof msg);
     if (rc != 0) {
         CHECK(has_location(msg, name, count_lines(text, len ? len : strlen(text))),
               "%s: the error '%s' does not name %s:LINE:COL", what, msg, name);

@@ -39,6 +39,7 @@
 #include "check.h"
 #include "support/image.h"
 #include "integrator.h"
+#include "library_path.h"
 #include "parser.h"
 #include "scene.h"
 #include "support/tiles.h"
@@ -140,6 +141,7 @@ static int render_scene(const char *dir, const char *name, int m, rs_image *img)
     char path[4096], msg[1024] = "";
     rs_scene sc;
     rs_parse_opts po;
+    const char *dirs[4];
     rs_render_opts ro;
     rs_integrator *it = NULL;
     int rc = -1;
@@ -150,6 +152,8 @@ static int render_scene(const char *dir, const char *name, int m, rs_image *img)
     rs_parse_opts_init(&po);
     po.image_width = W;
     po.image_height = H;
+    po.include_dirs = dirs;
+    po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
     rs_render_opts_init(&ro);
     ro.mode = mode;
     ro.width = W;
