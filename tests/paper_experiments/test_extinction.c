@@ -169,15 +169,6 @@ static int run(const char *scene_path, const char *step, const char *na_max, con
     return n;
 }
 
-static int is_png(const char *path)
-{
-    size_t n = 0;
-    char *d = tf_read(path, &n);
-    int ok = d && n > 8 && memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0;
-    free(d);
-    return ok;
-}
-
 static void test_against_closed_form(void)
 {
     const char *sp = LP_TEST_TMP "/extinction_test.scene";
@@ -186,7 +177,7 @@ static void test_against_closed_form(void)
     CHECK(tf_write(sp, scene, strlen(scene)) == 0, "writes the test scene");
     int n = run(sp, "0.05", "0.25", csv, png, rows, 16);
     CHECK(n == 5, "five points (%d)", n);
-    CHECK(is_png(png), "the chart is a PNG");
+    CHECK(tf_is_png(png), "the chart is a PNG");
     double worst = 0, worst_h = 0;
     for (int i = 0; i < n; i++) {
         double h, leak, rim;

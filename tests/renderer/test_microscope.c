@@ -30,41 +30,21 @@
 #include <string.h>
 
 #include "check.h"
-#include "integrator.h"
-#include "parser.h"
-#include "scene.h"
+#include "render_check.h"
+#include "test_files.h"
 
 #define PI 3.14159265358979323846
 
 static const double NO = 1.6584, NE = 1.4864, D_MM = 0.2, LAMBDA = 580.0;
 #define W 301 /* odd: the middle row runs through the axis */
 
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    char *t = NULL;
-    long n;
-    if (!f)
-        return NULL;
-    if (fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0 &&
-        (t = malloc((size_t)n + 1)) != NULL) {
-        if (fread(t, 1, (size_t)n, f) != (size_t)n) {
-            free(t);
-            t = NULL;
-        } else {
-            t[n] = '\0';
-        }
-    }
-    fclose(f);
-    return t;
-}
-
 /* The scene with the declarations in front, parsed and prepared. */
 static int load(const char *declares, rs_scene *sc)
 {
-    char path[4096], msg[512] = "";
+    char path[4096];
     snprintf(path, sizeof path, "%s/scenes/microscope/microscope.scene", LP_SOURCE_DIR);
-    char *body = read_text(path);
+    rs_scene_init(sc);
+    char *body = tf_read(path, NULL);
     if (!body) {
         fprintf(stderr, "cannot read %s\n", path);
         return -1;
@@ -72,52 +52,28 @@ static int load(const char *declares, rs_scene *sc)
     size_t n = strlen(declares) + strlen(body) + 2;
     char *text = malloc(n);
     int rc = -1;
-    rs_parse_opts po;
-    rs_parse_opts_init(&po);
-    po.image_width = W;
-    po.image_height = W;
-    rs_scene_init(sc);
     if (text) {
         snprintf(text, n, "%s\n%s", declares, body);
-        rc = rs_parse_string(text, "microscope.scene", &po, sc, msg, sizeof msg) == 0 &&
-                     rs_scene_prepare(sc, msg, sizeof msg) == 0
-                 ? 0
-                 : -1;
+        rc = rc_load_scene(sc, text, NULL, W, W);
     }
-    if (rc != 0)
-        fprintf(stderr, "microscope.scene: %s\n", msg);
     free(text);
     free(body);
     return rc;
 }
 
-/* The green channel of the middle row (j = (W - 1)/2) of the W x W image. */
+/* The green channel of the middle row (j = (W - 1)/2) of the W x W image,
+ * at 580 nm (one wavelength band). */
 static int render_row(const rs_scene *sc, double *v)
 {
-    char msg[512] = "";
-    rs_render_opts o;
-    rs_integrator *it = NULL;
-    rs_render_opts_init(&o);
-    o.mode = RS_MODE_POLARIZED;
-    o.width = W;
-    o.height = W;
-    o.wavelengths = 1;
-    if (rs_integrator_create(sc, &o, &it, msg, sizeof msg) != 0) {
-        fprintf(stderr, "render_row: %s\n", msg);
+    static unsigned char mask[W * W];
+    picture pic;
+    memset(mask, 0, sizeof mask);
+    memset(mask + (size_t)W * ((W - 1) / 2), 1, W);
+    if (rc_render(sc, RS_MODE_POLARIZED, W, W, 0, -1, 1, mask, &pic) != 0)
         return -1;
-    }
-    rs_worker *w = rs_worker_create(it);
-    if (!w) {
-        rs_integrator_destroy(it);
-        return -1;
-    }
-    for (int i = 0; i < W; i++) {
-        rs_color c;
-        rs_integrator_pixel(it, w, i, (W - 1) / 2, &c);
-        v[i] = c.g;
-    }
-    rs_worker_destroy(w);
-    rs_integrator_destroy(it);
+    for (int i = 0; i < W; i++)
+        v[i] = rc_px(&pic, i, (W - 1) / 2, 1);
+    free(pic.rgb);
     return 0;
 }
 
