@@ -84,18 +84,25 @@ struct rs_integrator {
                                    then the lights' lines */
     int n_lanes;
     rs_lane_classes *classes;   /* lanes with equal optics per lens */
+    double *lane_light;         /* [k * n_lanes + lane]: band_light of light
+                                   k in each lane, once per render */
+    double *lane_background;    /* per lane: the background's emission */
 };
 
 typedef struct frame {
     lp_backward *bw;
     bundle child;
-    bundle one;     /* the rays of one lane of child */
     lp_result res;
+    /* Shared gathers (gather_shared): per ray of child its group; per
+     * group its first ray and the range of its outputs in res. */
+    size_t *g_of, *g_ray, *g_start, *g_count, g_cap;
+    unsigned char *bad; /* per lane: a gather failed */
     /* A spectral packet's split at this level (n_lanes entries each). */
     int *lane, *pos;
     double *val, *acc;
     unsigned char *done;
     double *reach;  /* per light: light_reach memo of one shaded point */
+    double *cb, *hs; /* per light: shade_point's cosine terms and highlights */
 } frame;
 
 struct rs_worker {
@@ -104,7 +111,8 @@ struct rs_worker {
     int *lane_all;       /* 0 .. n_lanes - 1 */
     double *lane_value;  /* a pixel's value per lane */
     bundle pixel;
-    bundle one;          /* the rays of one lane of pixel */
+    bundle one;          /* pixel's rays sorted by lane */
+    size_t *lane_at;     /* n_lanes + 1: where each lane's rays are in one */
     rs_wavelets wavelets; /* of the band being traced (coherence.h) */
     uint64_t splits;      /* crystal lens hits, for rs_coherence_split */
 };
@@ -164,6 +172,8 @@ static int invert3(const double a[3][3], double out[3][3])
         }
     return 1;
 }
+
+static int make_lane_tables(rs_integrator *it);
 
 /* The lanes of a pixel (see struct rs_integrator) and their classes. */
 static int make_lanes(rs_integrator *it)
@@ -285,7 +295,7 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
             it->coherent[src_light(it, (int)k)] = 1;
             it->coherence[src_light(it, (int)k)] = scene->lights[k].coherence_length;
         }
-    if (make_lanes(it) != 0) {
+    if (make_lanes(it) != 0 || make_lane_tables(it) != 0) {
         rs_integrator_destroy(it);
         snprintf(msg, msg_size, "out of memory");
         return -1;
@@ -304,6 +314,8 @@ void rs_integrator_destroy(rs_integrator *it)
     free(it->light_rgb);
     free(it->lanes);
     rs_lane_classes_destroy(it->classes);
+    free(it->lane_light);
+    free(it->lane_background);
     free(it);
 }
 
@@ -315,7 +327,8 @@ rs_worker *rs_worker_create(const rs_integrator *it)
     w->it = it;
     w->lane_all = calloc((size_t)it->n_lanes, sizeof *w->lane_all);
     w->lane_value = calloc((size_t)it->n_lanes, sizeof *w->lane_value);
-    if (!w->lane_all || !w->lane_value) {
+    w->lane_at = calloc((size_t)it->n_lanes + 1, sizeof *w->lane_at);
+    if (!w->lane_all || !w->lane_value || !w->lane_at) {
         rs_worker_destroy(w);
         return NULL;
     }
@@ -334,8 +347,13 @@ void rs_worker_destroy(rs_worker *w)
         lp_backward_destroy(w->frames[f]->bw);
         free(w->frames[f]->child.r);
         free(w->frames[f]->child.lane);
-        free(w->frames[f]->one.r);
-        free(w->frames[f]->one.lane);
+        free(w->frames[f]->g_of);
+        free(w->frames[f]->g_ray);
+        free(w->frames[f]->g_start);
+        free(w->frames[f]->g_count);
+        free(w->frames[f]->bad);
+        free(w->frames[f]->cb);
+        free(w->frames[f]->hs);
         lp_result_release(&w->frames[f]->res);
         free(w->frames[f]->lane);
         free(w->frames[f]->pos);
@@ -347,6 +365,7 @@ void rs_worker_destroy(rs_worker *w)
     }
     free(w->lane_all);
     free(w->lane_value);
+    free(w->lane_at);
     free(w->pixel.r);
     free(w->pixel.lane);
     free(w->one.r);
@@ -370,7 +389,11 @@ static frame *get_frame(rs_worker *w, int f)
         fr->acc = calloc(n, sizeof *fr->acc);
         fr->done = calloc(n, 1);
         fr->reach = calloc(w->it->scene->n_lights + 1, sizeof *fr->reach);
-        if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach ||
+        fr->bad = calloc(n, 1);
+        fr->cb = calloc(w->it->scene->n_lights + 1, sizeof *fr->cb);
+        fr->hs = calloc(w->it->scene->n_lights + 1, sizeof *fr->hs);
+        if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach || !fr->bad ||
+            !fr->cb || !fr->hs ||
             lp_backward_create(&fr->bw, NULL) != LP_OK) {
             free(fr->lane);
             free(fr->pos);
@@ -378,6 +401,9 @@ static frame *get_frame(rs_worker *w, int f)
             free(fr->acc);
             free(fr->done);
             free(fr->reach);
+            free(fr->bad);
+            free(fr->cb);
+            free(fr->hs);
             free(fr);
             return NULL;
         }
@@ -404,20 +430,6 @@ static lp_ray *bundle_push(bundle *b, int lane)
     }
     b->lane[b->n] = lane;
     return &b->r[b->n++];
-}
-
-/* one = the rays of lane `lane` in b, in b's order; -1 when out of memory. */
-static int bundle_select(const bundle *b, int lane, bundle *one)
-{
-    one->n = 0;
-    for (size_t i = 0; i < b->n; i++)
-        if (b->lane[i] == lane) {
-            lp_ray *r = bundle_push(one, lane);
-            if (!r)
-                return -1;
-            *r = b->r[i];
-        }
-    return 0;
 }
 
 /* ---- small vector helpers ---- */
@@ -458,7 +470,7 @@ static double band_reflectance(const band *b, rs_color c)
     return rs_reflectance(c, b->lambda);
 }
 
-static double band_light(const rs_integrator *it, const band *b, int k)
+static double band_light_eval(const rs_integrator *it, const band *b, int k)
 {
     const rs_light *l = &it->scene->lights[k];
     if (b->kind == BAND_RGB)
@@ -470,6 +482,28 @@ static double band_light(const rs_integrator *it, const band *b, int k)
     rs_spectrum s = l->spectrum;
     s.rgb = l->color; /* the colour, or the tint of a blackbody */
     return rs_spectrum_emission_norm(&s, it->light_norm[k], b->lambda);
+}
+
+/* The power of light k in band b (one of it->lanes), from the table. */
+static double band_light(const rs_integrator *it, const band *b, int k)
+{
+    return it->lane_light[(size_t)k * (size_t)it->n_lanes + (size_t)(b - it->lanes)];
+}
+
+/* The tables of light and background per lane (see struct rs_integrator). */
+static int make_lane_tables(rs_integrator *it)
+{
+    size_t nl = it->scene->n_lights, n = (size_t)it->n_lanes;
+    it->lane_light = calloc(nl * n + 1, sizeof *it->lane_light);
+    it->lane_background = calloc(n + 1, sizeof *it->lane_background);
+    if (!it->lane_light || !it->lane_background)
+        return -1;
+    for (size_t k = 0; k < nl; k++)
+        for (size_t i = 0; i < n; i++)
+            it->lane_light[k * n + i] = band_light_eval(it, &it->lanes[i], (int)k);
+    for (size_t i = 0; i < n; i++)
+        it->lane_background[i] = band_emission(&it->lanes[i], it->scene->background);
+    return 0;
 }
 
 static rs_color pigment_at(const rs_pigment *p, lp_vec3 x)
@@ -632,20 +666,54 @@ static double highlight(const rs_finish *f, lp_vec3 n, lp_vec3 d, lp_vec3 l)
     return s;
 }
 
-/* Light leaving a surface towards the viewer along d, per source: emission,
- * ambient, and for each visible light diffuse (N.L)^brilliance plus the
- * highlights.  Calls emit(source, radiance) for each non-zero source.
- * reach, when not NULL, holds light_reach of each light from this hit (NaN
- * where not yet known): the lanes of a packet share their shadow rays
- * through it. */
-static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_vec3 dir,
-                  double *reach,
-                  emit_fn emit, void *ctx)
+/* What shading a point needs that no band changes, computed once for all
+ * the lanes of a packet: the pigment, the shadow-ray origin, per light
+ * the cosine term (c^brilliance, or -1 where the light is behind) and the
+ * highlights, and the memo of light_reach. */
+typedef struct shade_point {
+    const rs_hit *h;
+    rs_color pig;
+    lp_vec3 x;
+    double *cb, *s, *reach; /* per light */
+} shade_point;
+
+static void shade_begin(const rs_integrator *it, const rs_hit *h, lp_vec3 dir, frame *fr,
+                        shade_point *sp)
 {
     const rs_scene *sc = it->scene;
     const rs_object *o = &sc->objects[h->object];
     const rs_finish *f = &o->finish;
-    rs_color pig = pigment_at(&o->pigment, h->point);
+    sp->h = h;
+    sp->pig = pigment_at(&o->pigment, h->point);
+    sp->x = madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
+    sp->cb = fr->cb;
+    sp->s = fr->hs;
+    sp->reach = fr->reach;
+    for (size_t k = 0; k < sc->n_lights; k++) {
+        const rs_light *l = &sc->lights[k];
+        lp_vec3 x = sp->x;
+        lp_vec3 ld = unit((lp_vec3){l->position.x - x.x, l->position.y - x.y,
+                                    l->position.z - x.z});
+        double c = dot(ld, h->normal);
+        sp->s[k] = highlight(f, h->normal, dir, ld);
+        sp->cb[k] = c > 0.0 ? (f->brilliance == 1.0 ? c : pow(c, f->brilliance)) : -1.0;
+        sp->reach[k] = NAN;
+    }
+}
+
+/* Light leaving the surface at sp towards the viewer, in band b, per
+ * source: emission, ambient, and for each visible light diffuse
+ * (N.L)^brilliance plus the highlights.  Calls emit(source, radiance) for
+ * each non-zero source.  The lanes of a packet share sp, and with it
+ * their shadow rays. */
+static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_fn emit,
+                  void *ctx)
+{
+    const rs_scene *sc = it->scene;
+    const rs_hit *h = sp->h;
+    const rs_object *o = &sc->objects[h->object];
+    const rs_finish *f = &o->finish;
+    rs_color pig = sp->pig;
     double e = band_emission(b, mul(pig, f->emission));
     if (e != 0.0)
         emit(ctx, src_object(it, h->object), e);
@@ -657,26 +725,17 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_ve
     double rho = band_reflectance(b, pig) * f->diffuse;
     if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
         return;
-    lp_vec3 x = madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
     for (size_t k = 0; k < sc->n_lights; k++) {
-        const rs_light *l = &sc->lights[k];
-        lp_vec3 ld = unit((lp_vec3){l->position.x - x.x, l->position.y - x.y,
-                                    l->position.z - x.z});
-        double c = dot(ld, h->normal);
-        double s = highlight(f, h->normal, dir, ld);
-        double diff = c > 0.0 ? rho * (f->brilliance == 1.0 ? c : pow(c, f->brilliance)) : 0.0;
+        double s = sp->s[k];
+        double diff = sp->cb[k] >= 0.0 ? rho * sp->cb[k] : 0.0;
         if (diff + s <= 0.0)
             continue;
         double p = band_light(it, b, (int)k);
         if (p == 0.0)
             continue;
-        if (!reach)
-            p *= light_reach(it, x, (int)k);
-        else {
-            if (isnan(reach[k]))
-                reach[k] = light_reach(it, x, (int)k);
-            p *= reach[k];
-        }
+        if (isnan(sp->reach[k]))
+            sp->reach[k] = light_reach(it, sp->x, (int)k);
+        p *= sp->reach[k];
         if (p == 0.0)
             continue;
         emit(ctx, src_light(it, (int)k), (diff + s) * p);
@@ -742,7 +801,7 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
 
     if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
         for (int k = 0; k < n; k++)
-            out[k] = band_emission(&it->lanes[lane[k]], sc->background);
+            out[k] = it->lane_background[lane[k]];
         return;
     }
     for (int k = 0; k < n; k++)
@@ -790,25 +849,16 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
         return;
     }
     frame *fr = get_frame(w, f);
-    if (fr)
-        for (size_t k = 0; k < sc->n_lights; k++)
-            fr->reach[k] = NAN;
+    if (!fr)
+        return;
+    shade_point sp;
+    shade_begin(it, &h, d, fr, &sp);
     for (int k = 0; k < n; k++)
-        shade(it, &it->lanes[lane[k]], &h, d, fr ? fr->reach : NULL, emit_sum, &out[k]);
+        shade(it, &it->lanes[lane[k]], &sp, emit_sum, &out[k]);
     if (!has_reflection(&ob->finish) || level >= it->max_level || f + 1 >= RS_MAX_FRAMES)
         return;
     lp_vec3 rd = unit(madd(d, h.normal, -2.0 * dot(d, h.normal)));
     lp_vec3 x = madd(h.point, h.normal, 1e-9 * (1.0 + sqrt(dot(h.point, h.point))));
-    if (!fr) { /* no memory for the split: one lane at a time */
-        for (int k = 0; k < n; k++) {
-            double r = reflectivity(&it->lanes[lane[k]], ob, &h, d), v;
-            if (r > 0.0 && weight * r >= it->cutoff) {
-                trace_scalar(w, &lane[k], 1, x, rd, level + 1, weight * r, -1, f + 1, &v);
-                out[k] += r * v;
-            }
-        }
-        return;
-    }
     /* The mirror ray, shared by the lanes of equal reflectivity (they
      * carry the same weight on). */
     for (int k = 0; k < n; k++) {
@@ -837,24 +887,35 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
 
 typedef struct emit_ctx {
     bundle *out;
-    lp_vec3 d;
-    long wavelet; /* its index in the worker's table */
+    lp_vec3 v1, v2; /* the halves' fields, across the ray's direction */
+    long wavelet;   /* its index in the worker's table */
     int lane;
 } emit_ctx;
+
+/* An emit_ctx for light leaving along -d into out. */
+static emit_ctx emit_ctx_make(bundle *out, lp_vec3 d, long wavelet)
+{
+    lp_vec3 h = fabs(d.y) < 0.9 ? (lp_vec3){0, 1, 0} : (lp_vec3){1, 0, 0};
+    emit_ctx e;
+    e.out = out;
+    e.v1 = unit(cross(d, h));
+    e.v2 = cross(d, e.v1);
+    e.wavelet = wavelet;
+    e.lane = 0;
+    return e;
+}
 
 /* Natural light of one source as two orthogonal incoherent halves. */
 static void emit_halves(void *ctx, int source, double radiance)
 {
     emit_ctx *e = ctx;
-    lp_vec3 h = fabs(e->d.y) < 0.9 ? (lp_vec3){0, 1, 0} : (lp_vec3){1, 0, 0};
-    lp_vec3 v1 = unit(cross(e->d, h)), v2 = cross(e->d, v1);
     for (int half = 0; half < 2; half++) {
         lp_ray *r = bundle_push(e->out, e->lane);
         if (!r)
             return;
         memset(r, 0, sizeof *r);
         r->intensity = 0.5 * radiance;
-        r->vp = half ? v2 : v1;
+        r->vp = half ? e->v2 : e->v1;
         r->op = 0.0;
         r->ch = rs_coherence_ch(e->wavelet, source, half);
     }
@@ -921,6 +982,87 @@ static void mirror_pol(rs_worker *w, const int *lane, int n, const rs_object *ob
     }
 }
 
+/* Whether rays a and b differ in nothing a gather reads but intensity
+ * (both non-zero). */
+static int same_but_intensity(const lp_ray *a, const lp_ray *b)
+{
+    return a->ch == b->ch && a->op == b->op && a->kphi == b->kphi && a->phase == b->phase &&
+           a->vp.x == b->vp.x && a->vp.y == b->vp.y && a->vp.z == b->vp.z &&
+           a->dir.x == b->dir.x && a->dir.y == b->dir.y && a->dir.z == b->dir.z &&
+           a->origin.x == b->origin.x && a->origin.y == b->origin.y &&
+           a->origin.z == b->origin.z && a->intensity > 0.0 && b->intensity > 0.0;
+}
+
+/* Gather the rays of fr->child (lanes of equal optics at this lens) along
+ * query j, appending the outputs to out, each tagged with its ray's lane.
+ * Rays of different lanes that differ only in intensity (the same light
+ * seen in several wavelengths of equal optics) form a group gathered once:
+ * a gather is linear in the intensity, so the others' outputs are the
+ * first's scaled by their intensity ratio (a gather of their own gives the
+ * same to rounding).  A lane one of whose rays fails to gather gets nothing
+ * from this query, as a gather of its rays alone would give.  Returns -1
+ * when out of memory. */
+static int gather_shared(frame *fr, size_t j, int split, uint64_t hit, const lp_query *q,
+                         bundle *out)
+{
+    const bundle *c = &fr->child;
+    size_t n = c->n, n_g = 0;
+    if (n > fr->g_cap) {
+        size_t **arr[4] = {&fr->g_of, &fr->g_ray, &fr->g_start, &fr->g_count};
+        for (int k = 0; k < 4; k++) {
+            size_t *p = realloc(*arr[k], n * sizeof *p);
+            if (!p)
+                return -1;
+            *arr[k] = p;
+        }
+        fr->g_cap = n;
+    }
+    lp_result_clear(&fr->res);
+    for (size_t i = 0; i < n; i++) {
+        /* lanes emit in the same order: try the group after the last one */
+        size_t g = i > 0 ? fr->g_of[i - 1] + 1 : 0;
+        if (!(g < n_g && same_but_intensity(&c->r[fr->g_ray[g]], &c->r[i])))
+            for (g = 0; g < n_g && !same_but_intensity(&c->r[fr->g_ray[g]], &c->r[i]); g++)
+                ;
+        fr->g_of[i] = g;
+        if (g < n_g)
+            continue;
+        size_t before = fr->res.count;
+        fr->g_ray[g] = i;
+        fr->g_start[g] = before;
+        if (lp_backward_gather(fr->bw, j, &c->r[i], 1, &fr->res, NULL) != LP_OK) {
+            fr->res.count = before;
+            fr->g_count[g] = SIZE_MAX;
+        } else {
+            fr->g_count[g] = fr->res.count - before;
+        }
+        n_g++;
+    }
+    for (size_t i = 0; i < n; i++)
+        if (fr->g_count[fr->g_of[i]] == SIZE_MAX)
+            fr->bad[c->lane[i]] = 1;
+    for (size_t i = 0; i < n; i++) {
+        size_t g = fr->g_of[i];
+        if (fr->bad[c->lane[i]])
+            continue;
+        double I = c->r[i].intensity, I0 = c->r[fr->g_ray[g]].intensity;
+        double scale = I == I0 ? 1.0 : I / I0;
+        for (size_t t = fr->g_start[g]; t < fr->g_start[g] + fr->g_count[g]; t++) {
+            lp_ray *r = bundle_push(out, c->lane[i]);
+            if (!r)
+                return -1;
+            *r = fr->res.rays[t].ray;
+            if (scale != 1.0)
+                r->intensity *= scale;
+            if (split)
+                r->ch = rs_coherence_split(r->ch, hit, q[j].depth, q[j].kind != LP_KIND_REFLECT);
+        }
+    }
+    for (size_t i = 0; i < n; i++)
+        fr->bad[c->lane[i]] = 0;
+    return 0;
+}
+
 /* The bundles of lanes lane[0..n) seen along the ray, appended to out,
  * each ray tagged with its lane.  The lanes travel as one packet and
  * split at a lens where their optics differ, as in trace_scalar; the rays
@@ -934,9 +1076,9 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
     size_t start = out->n;
 
     if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
-        emit_ctx e = {out, d, -1, 0};
+        emit_ctx e = emit_ctx_make(out, d, -1);
         for (int k = 0; k < n; k++) {
-            double L = band_emission(&it->lanes[lane[k]], sc->background);
+            double L = it->lane_background[lane[k]];
             if (L == 0.0)
                 continue;
             if (e.wavelet < 0 && (e.wavelet = record_wavelet(w, o, d, NULL)) < 0)
@@ -975,27 +1117,25 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
                 fr->child.n = 0;
                 trace_pol(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
                           weight * q[j].bound, -1, f + 1, &fr->child);
-                for (int k = 0; k < m && fr->child.n > 0; k++) {
-                    const bundle *one = &fr->child;
-                    if (m > 1) { /* this lane's rays alone */
-                        if (bundle_select(&fr->child, fr->lane[k], &fr->one) != 0)
-                            return;
-                        one = &fr->one;
-                    }
-                    if (one->n == 0)
-                        continue;
-                    lp_result_clear(&fr->res);
-                    if (lp_backward_gather(fr->bw, j, one->r, one->n, &fr->res, NULL) != LP_OK)
-                        continue;
-                    for (size_t i = 0; i < fr->res.count; i++) {
-                        lp_ray *r = bundle_push(out, fr->lane[k]);
-                        if (!r)
-                            return;
-                        *r = fr->res.rays[i].ray;
-                        if (split)
-                            r->ch = rs_coherence_split(r->ch, hit, q[j].depth,
-                                                       q[j].kind != LP_KIND_REFLECT);
-                    }
+                if (fr->child.n == 0)
+                    continue;
+                if (m > 1) {
+                    if (gather_shared(fr, j, split, hit, q, out) != 0)
+                        return;
+                    continue;
+                }
+                lp_result_clear(&fr->res);
+                if (lp_backward_gather(fr->bw, j, fr->child.r, fr->child.n, &fr->res, NULL) !=
+                    LP_OK)
+                    continue;
+                for (size_t i = 0; i < fr->res.count; i++) {
+                    lp_ray *r = bundle_push(out, fr->lane[0]);
+                    if (!r)
+                        return;
+                    *r = fr->res.rays[i].ray;
+                    if (split)
+                        r->ch = rs_coherence_split(r->ch, hit, q[j].depth,
+                                                   q[j].kind != LP_KIND_REFLECT);
                 }
             }
         }
@@ -1026,13 +1166,13 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
         shift_op(out, start, h.t);
         return;
     }
-    emit_ctx e = {out, d, record_wavelet(w, o, d, &h), 0};
+    emit_ctx e = emit_ctx_make(out, d, record_wavelet(w, o, d, &h));
     if (e.wavelet >= 0) {
-        for (size_t k = 0; k < sc->n_lights; k++)
-            fr->reach[k] = NAN;
+        shade_point sp;
+        shade_begin(it, &h, d, fr, &sp);
         for (int k = 0; k < n; k++) {
             e.lane = lane[k];
-            shade(it, &it->lanes[lane[k]], &h, d, fr->reach, emit_halves, &e);
+            shade(it, &it->lanes[lane[k]], &sp, emit_halves, &e);
         }
     }
     if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES)
@@ -1041,24 +1181,37 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
 
 /* The polarized mode's power seen along a camera ray in every lane, into
  * L[0..n_lanes): the lanes traced as one packet, each lane's power from
- * its own rays. */
+ * its own rays, in their order. */
 static void pol_values(rs_worker *w, lp_vec3 o, lp_vec3 d, double *L)
 {
     const rs_integrator *it = w->it;
+    int nl = it->n_lanes;
     w->pixel.n = 0;
     w->wavelets.n = 0;
-    trace_pol(w, w->lane_all, it->n_lanes, o, d, 1, 1.0, -1, 0, &w->pixel);
-    for (int k = 0; k < it->n_lanes; k++) {
-        const bundle *one = &w->pixel;
-        if (it->n_lanes > 1) {
-            if (bundle_select(&w->pixel, k, &w->one) != 0) {
+    trace_pol(w, w->lane_all, nl, o, d, 1, 1.0, -1, 0, &w->pixel);
+    const bundle *p = &w->pixel;
+    /* a stable counting sort of the rays by lane into w->one */
+    size_t *at = w->lane_at;
+    for (int k = 0; k <= nl; k++)
+        at[k] = 0;
+    for (size_t i = 0; i < p->n; i++)
+        at[p->lane[i] + 1]++;
+    for (int k = 0; k < nl; k++)
+        at[k + 1] += at[k];
+    w->one.n = 0;
+    for (size_t i = 0; i < p->n; i++)
+        if (!bundle_push(&w->one, 0)) {
+            for (int k = 0; k < nl; k++)
                 L[k] = 0.0;
-                continue;
-            }
-            one = &w->one;
+            return;
         }
-        L[k] = rs_coherent_power(one->r, one->n, &w->wavelets, it->coherent, it->coherence,
-                                 it->n_sources, it->lanes[k].lambda);
+    for (size_t i = 0; i < p->n; i++)
+        w->one.r[at[p->lane[i]]++] = p->r[i];
+    /* at[k] is now the end of lane k's rays */
+    for (int k = 0; k < nl; k++) {
+        size_t from = k ? at[k - 1] : 0;
+        L[k] = rs_coherent_power(w->one.r + from, at[k] - from, &w->wavelets, it->coherent,
+                                 it->coherence, it->n_sources, it->lanes[k].lambda);
     }
 }
 
