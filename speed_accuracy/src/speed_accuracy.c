@@ -59,7 +59,12 @@ static const char *const usage_text[] = {
 "to the cap, and depth 64).  ERROR: RMSE of linear RGB against it, the\n"
 "largest channel difference, and the share of pixels with a channel off\n"
 "by more than 1/255 after the sRGB curve.  TIME: CPU seconds of the\n"
-"lensrender (or povray) process, --threads 1.\n",
+"lensrender (or povray) process, --threads 1.\n"
+"\n"
+"ACROSS PROCESSES: mpirun -n N speed_accuracy ... (a build with MPI) shares\n"
+"the references, then the points, among N processes (each needs the\n"
+"scenes and --bin at the same paths, and a --work directory of its own or\n"
+"a shared one); rank 0 writes the same table but for the times.\n",
 };
 
 typedef struct opts {

@@ -20,7 +20,7 @@ static void sanitizer_settings(void)
     setenv("LSAN_OPTIONS", "suppressions=" LP_SOURCE_DIR "/tests/mpi/lsan_mpi.supp", 1);
 }
 
-int ml_run(int n, const char *program, const char *const args[], tp_result *r)
+int ml_run(int n, int seconds, const char *program, const char *const args[], tp_result *r)
 {
     const char *argv[64];
     char count[16], limit[16];
@@ -33,7 +33,7 @@ int ml_run(int n, const char *program, const char *const args[], tp_result *r)
         setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
     }
     snprintf(count, sizeof count, "%d", n);
-    snprintf(limit, sizeof limit, "%d", ML_TIMEOUT_S);
+    snprintf(limit, sizeof limit, "%d", seconds);
     argv[k++] = "-k";
     argv[k++] = "10";
     argv[k++] = limit;

@@ -41,7 +41,7 @@ static void sweep(int ranks, const char *docs, const char *work)
                           work, "--width", "4", "--height", "3", "--runs", "1", "--scene",
                           "default", "--max-wavelengths", "128", NULL};
     int rc = ranks == 0 ? tp_run(LP_BIN_DIR "/speed_accuracy", args, NULL, &r)
-                        : ml_run(ranks, LP_BIN_DIR "/speed_accuracy", args, &r);
+                        : ml_run(ranks, ML_TIMEOUT_S, LP_BIN_DIR "/speed_accuracy", args, &r);
     CHECK(rc == 0 && r.status == 0, "speed_accuracy on %d processes: status %d: %s", ranks,
           r.status, r.err ? r.err : r.error);
     printf("speed_accuracy on %d processes (0: without the launcher): %.2f s\n", ranks,
