@@ -8,16 +8,21 @@
 
 #include "mpi_launch.h"
 
-/* Under the sanitizers: what the MPI library keeps to the end is not a
- * leak of ours (lsan_mpi.supp); the slow unwinder sees its frames. */
-static void sanitizer_settings(void)
+void ml_environment(void)
 {
     char asan[1024];
     const char *old = getenv("ASAN_OPTIONS");
-    snprintf(asan, sizeof asan, "%s%sfast_unwind_on_malloc=0", old ? old : "",
-             old && *old ? ":" : "");
-    setenv("ASAN_OPTIONS", asan, 1);
+    if (!old || !strstr(old, "fast_unwind_on_malloc=0")) {
+        snprintf(asan, sizeof asan, "%s%sfast_unwind_on_malloc=0", old ? old : "",
+                 old && *old ? ":" : "");
+        setenv("ASAN_OPTIONS", asan, 1);
+    }
     setenv("LSAN_OPTIONS", "suppressions=" LP_SOURCE_DIR "/tests/mpi/lsan_mpi.supp", 1);
+    setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
+    if (geteuid() == 0) {
+        setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
+        setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
+    }
 }
 
 int ml_run(int n, int seconds, const char *program, const char *const args[], tp_result *r)
@@ -26,12 +31,7 @@ int ml_run(int n, int seconds, const char *program, const char *const args[], tp
     char count[16], limit[16];
     size_t k = 0;
 
-    setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
-    sanitizer_settings();
-    if (geteuid() == 0) {
-        setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
-        setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
-    }
+    ml_environment();
     snprintf(count, sizeof count, "%d", n);
     snprintf(limit, sizeof limit, "%d", seconds);
     argv[k++] = "-k";

@@ -60,6 +60,7 @@ int main(void)
     snprintf(c3, sizeof c3, "%s/speed-accuracy.csv", d3);
     remove(c1);
     remove(c3);
+    ml_environment();
     sweep(0, d1, w1);
     sweep(3, d3, w3);
 
