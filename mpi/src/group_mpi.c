@@ -123,3 +123,47 @@ void mw_group_end(mw_group *g)
     free(g);
     MPI_Finalize();
 }
+
+/* ---- the MPI library under the sanitizers ------------------------------
+ *
+ * Open MPI keeps allocations until the process ends (and unloads the
+ * components that made some): LeakSanitizer would report them as leaks of
+ * every program that starts MPI.  In a sanitizer build these defaults of
+ * the sanitizers' runtime suppress a leak whose allocation has a frame in
+ * the MPI library or what it loads, and take allocation stacks with the
+ * slow unwinder, which sees through those libraries' frames; the program's
+ * own leaks are still reported (and the table of what was suppressed is
+ * not printed).  ASAN_OPTIONS and LSAN_OPTIONS still override them. */
+#if defined(__SANITIZE_ADDRESS__)
+#define LPMPI_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define LPMPI_ASAN 1
+#endif
+#endif
+#if defined(LPMPI_ASAN)
+const char *__asan_default_options(void);
+const char *__lsan_default_suppressions(void);
+const char *__lsan_default_options(void);
+
+const char *__asan_default_options(void)
+{
+    return "fast_unwind_on_malloc=0";
+}
+
+const char *__lsan_default_suppressions(void)
+{
+    return "leak:libmpi.so\n"
+           "leak:libopen-pal.so\n"
+           "leak:libopen-rte.so\n"
+           "leak:libevent\n"
+           "leak:libpmix\n"
+           "leak:libhwloc\n"
+           "leak:mca_\n";
+}
+
+const char *__lsan_default_options(void)
+{
+    return "print_suppressions=0"; /* no table of what was suppressed */
+}
+#endif

@@ -10,14 +10,6 @@
 
 void ml_environment(void)
 {
-    char asan[1024];
-    const char *old = getenv("ASAN_OPTIONS");
-    if (!old || !strstr(old, "fast_unwind_on_malloc=0")) {
-        snprintf(asan, sizeof asan, "%s%sfast_unwind_on_malloc=0", old ? old : "",
-                 old && *old ? ":" : "");
-        setenv("ASAN_OPTIONS", asan, 1);
-    }
-    setenv("LSAN_OPTIONS", "suppressions=" LP_SOURCE_DIR "/tests/mpi/lsan_mpi.supp", 1);
     setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
     if (geteuid() == 0) {
         setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);

@@ -26,11 +26,8 @@
  * `seconds`; as tp_run. */
 int ml_run(int n, int seconds, const char *program, const char *const args[], tp_result *r);
 
-/* The environment ml_run gives the launcher (above), and, under the
- * sanitizers, what the MPI library keeps to the end is not a leak of ours
- * (lsan_mpi.supp, with the slow unwinder, which sees its frames).  Also
- * for a program of the MPI build run without the launcher (a run of one
- * process still starts the MPI library). */
+/* The environment ml_run gives the launcher (above); also for a program
+ * of the MPI build run without the launcher (a run of one process). */
 void ml_environment(void);
 
 /* The number of lines of text that start with prefix. */

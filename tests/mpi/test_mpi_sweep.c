@@ -1,8 +1,10 @@
-/* test_mpi_sweep.c -- the speed-accuracy sweep across processes gives
- * the table of one process: speed_accuracy alone and under the MPI
- * launcher on 3 processes (one scene, 4 x 3 pixels, one run per point),
- * their CSVs the same line for line and column for column but for the
- * times (column 8, seconds: a measurement, different in every run). */
+/* test_mpi_sweep.c -- the sweeps across processes give one process's
+ * outputs.  The speed-accuracy sweep: speed_accuracy alone and under the
+ * MPI launcher on 3 processes (one scene, 4 x 3 pixels, one run per
+ * point), their CSVs the same line for line and column for column but
+ * for the times (column 8, seconds: a measurement, different in every
+ * run).  The NA sweep of the empty microscope: extinction_na alone and on
+ * 3 processes, its CSV and chart the same bytes. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
@@ -49,6 +51,30 @@ static void sweep(int ranks, const char *docs, const char *work)
     tp_result_free(&r);
 }
 
+static int same_file(const char *a, const char *b)
+{
+    size_t na, nb;
+    char *x = tf_read(a, &na), *y = tf_read(b, &nb);
+    int same = x && y && na == nb && memcmp(x, y, na) == 0;
+    free(x);
+    free(y);
+    return same;
+}
+
+static void na_sweep(int ranks, const char *csv, const char *png)
+{
+    char scene[4096];
+    tp_result r;
+    snprintf(scene, sizeof scene, "%s/scenes/microscope/microscope_empty.scene", LP_SOURCE_DIR);
+    remove(csv);
+    const char *args[] = {"--scene", scene, "--csv", csv, "--png", png, NULL};
+    int rc = ranks == 0 ? tp_run(LP_BIN_DIR "/extinction_na", args, NULL, &r)
+                        : ml_run(ranks, ML_TIMEOUT_S, LP_BIN_DIR "/extinction_na", args, &r);
+    CHECK(rc == 0 && r.status == 0, "extinction_na on %d processes: status %d: %s", ranks,
+          r.status, r.err ? r.err : r.error);
+    tp_result_free(&r);
+}
+
 int main(void)
 {
     char d1[2048], w1[2048], d3[2048], w3[2048], c1[4096], c3[4096];
@@ -89,5 +115,15 @@ int main(void)
     }
     free(a);
     free(b);
+
+    char na1[4096], na3[4096], pa1[4096], pa3[4096];
+    snprintf(na1, sizeof na1, "%s/mpi_sweep_na1.csv", LP_TEST_TMP);
+    snprintf(na3, sizeof na3, "%s/mpi_sweep_na3.csv", LP_TEST_TMP);
+    snprintf(pa1, sizeof pa1, "%s/mpi_sweep_na1.png", LP_TEST_TMP);
+    snprintf(pa3, sizeof pa3, "%s/mpi_sweep_na3.png", LP_TEST_TMP);
+    na_sweep(0, na1, pa1);
+    na_sweep(3, na3, pa3);
+    CHECK(same_file(na1, na3), "extinction_na: the CSV of 3 processes differs from one process's");
+    CHECK(same_file(pa1, pa3), "extinction_na: the chart of 3 processes differs from one process's");
     return check_finish("test_mpi_sweep");
 }
