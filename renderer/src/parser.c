@@ -778,8 +778,12 @@ static int parse_term(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '*') || is_punct(peek(p), '/')) {
         rs_token op = take(p);
-        val b;
-        if (parse_unary(p, &b) != 0 || binary(p, &op, out, b) != 0)
+        val b = { 0 };   /* nothing to free until parsed */
+        if (parse_unary(p, &b) != 0) {
+            rs__val_free(&b);
+            return -1;
+        }
+        if (binary(p, &op, out, b) != 0)
             return -1;
     }
     return 0;
@@ -791,8 +795,12 @@ static int parse_sum(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '+') || is_punct(peek(p), '-')) {
         rs_token op = take(p);
-        val b;
-        if (parse_term(p, &b) != 0 || binary(p, &op, out, b) != 0)
+        val b = { 0 };   /* nothing to free until parsed */
+        if (parse_term(p, &b) != 0) {
+            rs__val_free(&b);
+            return -1;
+        }
+        if (binary(p, &op, out, b) != 0)
             return -1;
     }
     return 0;
@@ -820,7 +828,7 @@ static int parse_relation(parser *p, val *out)
         const rs_token *t = peek(p);
         rs_token op;
         char name[3] = { 0, 0, 0 };
-        val b;
+        val b = { 0 };   /* nothing to free until parsed */
         double x, y, r;
         if (!(is_punct(t, '=') || is_punct(t, '!') ||
               (!p->in_vector && out->kind == VAL_FLOAT &&
@@ -834,8 +842,10 @@ static int parse_relation(parser *p, val *out)
         } else if (op.punct == '!') {
             return expected(p, peek(p), "'=' after '!'");
         }
-        if (parse_sum(p, &b) != 0)
+        if (parse_sum(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         x = out->v[0];
         y = b.v[0];
         if (name[0] == '=')
@@ -857,9 +867,11 @@ static int parse_and(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '&')) {
         rs_token op = take(p);
-        val b;
-        if (parse_relation(p, &b) != 0)
+        val b = { 0 };   /* nothing to free until parsed */
+        if (parse_relation(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         if (compare(p, &op, "&", out, &b, out->v[0] != 0.0 && b.v[0] != 0.0) != 0)
             return -1;
     }
@@ -872,9 +884,11 @@ static int parse_or(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '|')) {
         rs_token op = take(p);
-        val b;
-        if (parse_and(p, &b) != 0)
+        val b = { 0 };   /* nothing to free until parsed */
+        if (parse_and(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         if (compare(p, &op, "|", out, &b, out->v[0] != 0.0 || b.v[0] != 0.0) != 0)
             return -1;
     }
