@@ -495,7 +495,7 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_ve
                   emit_fn emit, void *ctx)
 {
     const rs_scene *sc = it->scene;
-    const rs_object *o = &sc->objects[h->object];
+    const rs_object *o = h->surface;
     const rs_finish *f = &o->finish;
     rs_color pig = pigment_at(&o->pigment, h->point);
     double e = band_emission(b, mul(pig, f->emission));
@@ -584,7 +584,7 @@ static double trace_scalar(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, in
 
     if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h))
         return band_emission(b, sc->background);
-    const rs_object *ob = &sc->objects[h.object];
+    const rs_object *ob = h.surface;
     if (ob->type == RS_OBJ_LENS) {
         int dT = it->max_level - level;
         frame *fr = get_frame(w, f);
@@ -712,7 +712,7 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
             emit_halves(&e, 1, L);
         return;
     }
-    const rs_object *ob = &sc->objects[h.object];
+    const rs_object *ob = h.surface;
     frame *fr = get_frame(w, f);
     if (!fr)
         return;
