@@ -144,11 +144,11 @@ int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, do
         return 0;
     double sq = sqrt(disc);
     double lo = (-od - sq) / dd, hi = (-od + sq) / dd;
+    /* The roots are isolated over the sphere from t0 on, not cut at t1:
+     * the hit found does not depend on how near another object is. */
     if (lo < t0)
         lo = t0;
-    if (hi > t1)
-        hi = t1;
-    if (!(lo < hi))
+    if (!(lo < hi) || !(lo < t1))
         return 0;
     /* the quartic in s = t - lo, from the point where the ray enters the
      * bounding sphere (no cancellation from a far origin) */
