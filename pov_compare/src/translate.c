@@ -849,9 +849,11 @@ static void object_box_add(lp_vec3 *lo, lp_vec3 *hi, const rs_object *o)
 {
     lp_vec3 pts[LENS_SAMPLES];
     switch (o->type) {
-    case RS_OBJ_SPHERE: {
-        lp_vec3 c = o->u.sphere.center;
-        double r = fabs(o->u.sphere.radius);
+    case RS_OBJ_SPHERE:
+    case RS_OBJ_DISC: { /* both inside the cube of half-side r about c */
+        int sph = o->type == RS_OBJ_SPHERE;
+        lp_vec3 c = sph ? o->u.sphere.center : o->u.disc.center;
+        double r = fabs(sph ? o->u.sphere.radius : o->u.disc.radius);
         box_add_xf(lo, hi, &o->xf, (lp_vec3){ c.x - r, c.y - r, c.z - r },
                    (lp_vec3){ c.x + r, c.y + r, c.z + r });
         break;
@@ -859,13 +861,6 @@ static void object_box_add(lp_vec3 *lo, lp_vec3 *hi, const rs_object *o)
     case RS_OBJ_BOX:
         box_add_xf(lo, hi, &o->xf, o->u.box.corner1, o->u.box.corner2);
         break;
-    case RS_OBJ_DISC: {
-        lp_vec3 c = o->u.disc.center;
-        double r = fabs(o->u.disc.radius);
-        box_add_xf(lo, hi, &o->xf, (lp_vec3){ c.x - r, c.y - r, c.z - r },
-                   (lp_vec3){ c.x + r, c.y + r, c.z + r });
-        break;
-    }
     case RS_OBJ_POLARIZER: {
         lp_vec3 c = o->u.polarizer.center;
         double r = fabs(o->u.polarizer.radius);

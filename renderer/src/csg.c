@@ -116,6 +116,16 @@ int rs_csg_intersect(const rs_object *o, lp_vec3 origin, lp_vec3 dir, double t_m
     return found;
 }
 
+static lp_vec3 vmin(lp_vec3 a, lp_vec3 b)
+{
+    return (lp_vec3){fmin(a.x, b.x), fmin(a.y, b.y), fmin(a.z, b.z)};
+}
+
+static lp_vec3 vmax(lp_vec3 a, lp_vec3 b)
+{
+    return (lp_vec3){fmax(a.x, b.x), fmax(a.y, b.y), fmax(a.z, b.z)};
+}
+
 /* A member's box; none for an inverted one (it reaches infinity). */
 static int member_box(const rs_object *m, rs_bounds_fn member_bounds, lp_vec3 *lo, lp_vec3 *hi)
 {
@@ -131,45 +141,35 @@ int rs_csg_bounds(const rs_object *o, rs_bounds_fn member_bounds, lp_vec3 *lo, l
 
     if (o->inverse || n == 0)
         return 0;
-    switch (o->u.csg.op) {
-    case RS_CSG_DIFFERENCE:
+    if (o->u.csg.op == RS_CSG_DIFFERENCE) {
         if (!member_box(&m[0], member_bounds, &a, &b))
             return 0;
-        have = 1;
-        break;
-    case RS_CSG_INTERSECTION:
-        for (size_t i = 0; i < n; i++) {
-            if (!member_box(&m[i], member_bounds, &ma, &mb))
-                continue;
-            if (!have) {
-                a = ma;
-                b = mb;
-                have = 1;
-                continue;
-            }
-            a = (lp_vec3){fmax(a.x, ma.x), fmax(a.y, ma.y), fmax(a.z, ma.z)};
-            b = (lp_vec3){fmin(b.x, mb.x), fmin(b.y, mb.y), fmin(b.z, mb.z)};
-        }
-        if (!have)
-            return 0;
-        if (!(a.x <= b.x && a.y <= b.y && a.z <= b.z)) /* empty: a point */
-            b = a;
-        break;
-    default: /* union */
-        for (size_t i = 0; i < n; i++) {
-            if (!member_box(&m[i], member_bounds, &ma, &mb))
-                return 0;
-            if (!have) {
-                a = ma;
-                b = mb;
-                have = 1;
-                continue;
-            }
-            a = (lp_vec3){fmin(a.x, ma.x), fmin(a.y, ma.y), fmin(a.z, ma.z)};
-            b = (lp_vec3){fmax(b.x, mb.x), fmax(b.y, mb.y), fmax(b.z, mb.z)};
-        }
-        break;
+        *lo = a;
+        *hi = b;
+        return 1;
     }
+    /* an intersection: the common part of the boxes there are; a union:
+     * the hull of all of them */
+    int inter = o->u.csg.op == RS_CSG_INTERSECTION;
+    for (size_t i = 0; i < n; i++) {
+        if (!member_box(&m[i], member_bounds, &ma, &mb)) {
+            if (inter)
+                continue;
+            return 0;
+        }
+        if (!have) {
+            a = ma;
+            b = mb;
+            have = 1;
+            continue;
+        }
+        a = inter ? vmax(a, ma) : vmin(a, ma);
+        b = inter ? vmin(b, mb) : vmax(b, mb);
+    }
+    if (!have)
+        return 0;
+    if (!(a.x <= b.x && a.y <= b.y && a.z <= b.z)) /* an empty intersection: a point */
+        b = a;
     *lo = a;
     *hi = b;
     return 1;
