@@ -643,7 +643,7 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_ve
                   emit_fn emit, void *ctx)
 {
     const rs_scene *sc = it->scene;
-    const rs_object *o = &sc->objects[h->object];
+    const rs_object *o = h->surface;
     const rs_finish *f = &o->finish;
     rs_color pig = pigment_at(&o->pigment, h->point);
     double e = band_emission(b, mul(pig, f->emission));
@@ -747,7 +747,7 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     }
     for (int k = 0; k < n; k++)
         out[k] = 0.0;
-    const rs_object *ob = &sc->objects[h.object];
+    const rs_object *ob = h.surface;
     if (ob->type == RS_OBJ_LENS) {
         int dT = it->max_level - level, m;
         frame *fr = get_frame(w, f);
@@ -946,7 +946,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
         }
         return;
     }
-    const rs_object *ob = &sc->objects[h.object];
+    const rs_object *ob = h.surface;
     frame *fr = get_frame(w, f);
     if (!fr)
         return;
