@@ -681,7 +681,7 @@ static void shade_begin(const rs_integrator *it, const rs_hit *h, lp_vec3 dir, f
                         shade_point *sp)
 {
     const rs_scene *sc = it->scene;
-    const rs_object *o = &sc->objects[h->object];
+    const rs_object *o = h->surface;
     const rs_finish *f = &o->finish;
     sp->h = h;
     sp->pig = pigment_at(&o->pigment, h->point);
@@ -806,7 +806,7 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     }
     for (int k = 0; k < n; k++)
         out[k] = 0.0;
-    const rs_object *ob = &sc->objects[h.object];
+    const rs_object *ob = h.surface;
     if (ob->type == RS_OBJ_LENS) {
         int dT = it->max_level - level, m;
         frame *fr = get_frame(w, f);
@@ -1088,7 +1088,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
         }
         return;
     }
-    const rs_object *ob = &sc->objects[h.object];
+    const rs_object *ob = h.surface;
     frame *fr = get_frame(w, f);
     if (!fr)
         return;

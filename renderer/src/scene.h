@@ -90,8 +90,18 @@ typedef enum rs_object_type {
     RS_OBJ_POLARIZER,
     RS_OBJ_CYLINDER,
     RS_OBJ_CONE,
-    RS_OBJ_TORUS
+    RS_OBJ_TORUS,
+    RS_OBJ_CSG
 } rs_object_type;
+
+/* The set operations of a CSG object (csg.h): a union or merge inside an
+ * intersection or difference is one member of it, so it is kept as a
+ * node. */
+typedef enum rs_csg_op {
+    RS_CSG_UNION = 0,
+    RS_CSG_INTERSECTION,
+    RS_CSG_DIFFERENCE
+} rs_csg_op;
 
 typedef struct rs_object {
     rs_object_type type;
@@ -113,6 +123,9 @@ typedef struct rs_object {
         struct { lp_vec3 base, cap; double base_radius, cap_radius; int open; } cone;
         /* torus about the y axis, centred at the origin */
         struct { double major, minor; } torus;
+        /* intersection / difference (and a union inside them): the
+           members, owned, each with its transforms folded in (csg.h) */
+        struct { rs_csg_op op; struct rs_object *members; size_t n_members; } csg;
     } u;
     rs_transform xf;        /* object -> world (identity when none);
                                lenses and polarizers have it folded into
@@ -121,6 +134,8 @@ typedef struct rs_object {
     rs_finish finish;
     double ior;             /* interior { ior } (default 1): for fresnel
                                reflection of opaque objects */
+    int has_interior;       /* an interior was given (a CSG member without
+                               one takes its CSG's) */
     int has_texture;        /* a pigment, finish or texture was given (a
                                union passes its own to children without) */
     int inverse;            /* inside and outside swapped */
