@@ -711,7 +711,7 @@ static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_
 {
     const rs_scene *sc = it->scene;
     const rs_hit *h = sp->h;
-    const rs_object *o = &sc->objects[h->object];
+    const rs_object *o = h->surface;
     const rs_finish *f = &o->finish;
     rs_color pig = sp->pig;
     double e = band_emission(b, mul(pig, f->emission));
