@@ -780,7 +780,12 @@ static int parse_term(parser *p, val *out)
     while (is_punct(peek(p), '*') || is_punct(peek(p), '/')) {
         rs_token op = take(p);
         val b;
-        if (parse_unary(p, &b) != 0 || binary(p, &op, out, b) != 0)
+        memset(&b, 0, sizeof b);
+        if (parse_unary(p, &b) != 0) {
+            rs__val_free(&b);
+            return -1;
+        }
+        if (binary(p, &op, out, b) != 0)
             return -1;
     }
     return 0;
@@ -793,7 +798,12 @@ static int parse_sum(parser *p, val *out)
     while (is_punct(peek(p), '+') || is_punct(peek(p), '-')) {
         rs_token op = take(p);
         val b;
-        if (parse_term(p, &b) != 0 || binary(p, &op, out, b) != 0)
+        memset(&b, 0, sizeof b);
+        if (parse_term(p, &b) != 0) {
+            rs__val_free(&b);
+            return -1;
+        }
+        if (binary(p, &op, out, b) != 0)
             return -1;
     }
     return 0;
@@ -823,6 +833,7 @@ static int parse_relation(parser *p, val *out)
         char name[3] = { 0, 0, 0 };
         val b;
         double x, y, r;
+        memset(&b, 0, sizeof b);
         if (!(is_punct(t, '=') || is_punct(t, '!') ||
               (!p->in_vector && out->kind == VAL_FLOAT &&
                (is_punct(t, '<') || is_punct(t, '>')))))
@@ -835,8 +846,10 @@ static int parse_relation(parser *p, val *out)
         } else if (op.punct == '!') {
             return expected(p, peek(p), "'=' after '!'");
         }
-        if (parse_sum(p, &b) != 0)
+        if (parse_sum(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         x = out->v[0];
         y = b.v[0];
         if (name[0] == '=')
@@ -859,8 +872,11 @@ static int parse_and(parser *p, val *out)
     while (is_punct(peek(p), '&')) {
         rs_token op = take(p);
         val b;
-        if (parse_relation(p, &b) != 0)
+        memset(&b, 0, sizeof b);
+        if (parse_relation(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         if (compare(p, &op, "&", out, &b, out->v[0] != 0.0 && b.v[0] != 0.0) != 0)
             return -1;
     }
@@ -874,8 +890,11 @@ static int parse_or(parser *p, val *out)
     while (is_punct(peek(p), '|')) {
         rs_token op = take(p);
         val b;
-        if (parse_and(p, &b) != 0)
+        memset(&b, 0, sizeof b);
+        if (parse_and(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         if (compare(p, &op, "|", out, &b, out->v[0] != 0.0 || b.v[0] != 0.0) != 0)
             return -1;
     }
