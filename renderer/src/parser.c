@@ -779,8 +779,7 @@ static int parse_term(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '*') || is_punct(peek(p), '/')) {
         rs_token op = take(p);
-        val b;
-        memset(&b, 0, sizeof b);
+        val b = { 0 };   /* nothing to free until parsed */
         if (parse_unary(p, &b) != 0) {
             rs__val_free(&b);
             return -1;
@@ -797,8 +796,7 @@ static int parse_sum(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '+') || is_punct(peek(p), '-')) {
         rs_token op = take(p);
-        val b;
-        memset(&b, 0, sizeof b);
+        val b = { 0 };   /* nothing to free until parsed */
         if (parse_term(p, &b) != 0) {
             rs__val_free(&b);
             return -1;
@@ -831,9 +829,8 @@ static int parse_relation(parser *p, val *out)
         const rs_token *t = peek(p);
         rs_token op;
         char name[3] = { 0, 0, 0 };
-        val b;
+        val b = { 0 };   /* nothing to free until parsed */
         double x, y, r;
-        memset(&b, 0, sizeof b);
         if (!(is_punct(t, '=') || is_punct(t, '!') ||
               (!p->in_vector && out->kind == VAL_FLOAT &&
                (is_punct(t, '<') || is_punct(t, '>')))))
@@ -871,8 +868,7 @@ static int parse_and(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '&')) {
         rs_token op = take(p);
-        val b;
-        memset(&b, 0, sizeof b);
+        val b = { 0 };   /* nothing to free until parsed */
         if (parse_relation(p, &b) != 0) {
             rs__val_free(&b);
             return -1;
@@ -889,8 +885,7 @@ static int parse_or(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '|')) {
         rs_token op = take(p);
-        val b;
-        memset(&b, 0, sizeof b);
+        val b = { 0 };   /* nothing to free until parsed */
         if (parse_and(p, &b) != 0) {
             rs__val_free(&b);
             return -1;
