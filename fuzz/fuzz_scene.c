@@ -1,9 +1,9 @@
 /* fuzz_scene.c -- libFuzzer target: the .scene parser on arbitrary bytes.
  *
- * The input is parsed as scene text (a NUL-terminated copy: an embedded
- * NUL ends the text, as for rs_parse_string), then, when it parses, the
- * lenses are created (rs_scene_prepare), the camera is set up and a few
- * primary rays are intersected with the scene.  What the parser stores must
+ * The input is loaded as scene text through the renderer's face (a
+ * NUL-terminated copy: an embedded NUL ends the text, as for
+ * lr_scene_load_string), then, when it loads, a few primary rays are made
+ * and a 4 x 3 image is rendered (1 wavelength, depth 3, one thread).  What the parser stores must
  * be finite, with unit normals and positive sizes (parser.h); any
  * crash, sanitizer report, leak, hang or runaway allocation is a bug; a
  * refusal must come with a "<fuzz>:LINE:COL: ..." message.  #include is
@@ -16,10 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera.h"
-#include "parser.h"
-#include "scene.h"
-#include "shapes.h"
+#include "lensrender/lensrender.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -116,43 +113,45 @@ static void check_scene(const rs_scene *s)
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     char *text = malloc(size + 1);
-    char msg[512];
-    rs_scene scene;
-    rs_parse_opts opts;
-    rs_view view;
-    int rc;
+    lr_load_opts opts;
+    lr_scene *scene = NULL;
+    lr_error err;
 
     if (text == NULL)
         return 0;
     memcpy(text, data, size);
     text[size] = '\0';
-    rs_parse_opts_init(&opts);
+    lr_load_opts_init(&opts);
     opts.no_include = 1;       /* no file is opened */
     opts.max_tokens = 100000;  /* loops and macro recursion end fast */
     opts.max_objects = 2000;
-    rs_scene_init(&scene);
-    rc = rs_parse_string(text, "<fuzz>", &opts, &scene, msg, sizeof msg);
-    if (rc != 0) {
+    if (lr_scene_load_string(text, "<fuzz>", &opts, &scene, &err) != LR_OK) {
         /* A refusal must say where: "<fuzz>:LINE:COL: ..." */
-        require(strncmp(msg, "<fuzz>:", 7) == 0);
+        require(err.status == LR_ERROR_NO_MEMORY || strncmp(err.message, "<fuzz>:", 7) == 0);
     } else {
-        check_scene(&scene);
-        if (rs_scene_prepare(&scene, msg, sizeof msg) != 0) {
-            require(strncmp(msg, "<fuzz>:", 7) == 0);
-        } else if (rs_camera_setup(&scene.camera, 4, 3, &view, msg, sizeof msg) == 0) {
-            for (int j = 0; j < 3; j++) {
-                for (int i = 0; i < 4; i++) {
-                    lp_vec3 o, d;
-                    rs_hit hit;
-                    rs_camera_ray(&view, i + 0.5, j + 0.5, 4, 3, &o, &d);
+        const rs_scene *s = lr_scene_description(scene);
+        lr_render_opts ro;
+        lr_renderer *r = NULL;
+        float rgb[3 * 4 * 3];
+        require(s != NULL);
+        check_scene(s);
+        for (int j = 0; j < 3; j++)
+            for (int i = 0; i < 4; i++) {
+                lp_vec3 o, d;
+                if (lr_camera_ray(&s->camera, 4, 3, i + 0.5, j + 0.5, &o, &d, NULL) == LR_OK)
                     require(fin(o) && unit(d));
-                    if (rs_scene_intersect(&scene, o, d, 1e-9, 1e30, -1, &hit))
-                        require(isfinite(hit.t) && fin(hit.point) && unit(hit.normal));
-                }
             }
-        }
+        lr_render_opts_init(&ro);
+        ro.width = 4;
+        ro.height = 3;
+        ro.wavelengths = 1;
+        ro.depth = 3;
+        ro.threads = 1;
+        if (lr_renderer_create(scene, &ro, &r, &err) == LR_OK)
+            require(lr_render_image(r, rgb, NULL, NULL, &err) == LR_OK);
+        lr_renderer_free(r);
     }
-    rs_scene_free(&scene);
+    lr_scene_free(scene);
     free(text);
     return 0;
 }

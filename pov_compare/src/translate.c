@@ -32,8 +32,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera.h"
-#include "emitter.h"
+#include "lensrender/lensrender.h"
 
 #define PC_PI 3.14159265358979323846
 /* pc_pov_scale's largest factor.  Rays bent by a lens can travel far
@@ -391,44 +390,6 @@ static int note_straddling(const rs_scene *sc, const rs_object *o, pc_notes *not
 }
 
 /* ---- lights --------------------------------------------------------------- */
-
-static rs_color clamp_nonneg(rs_color c)
-{
-    return (rs_color){ c.r > 0.0 ? c.r : 0.0, c.g > 0.0 ? c.g : 0.0, c.b > 0.0 ? c.b : 0.0 };
-}
-
-/* The RGB colour POV-Ray gets for a light: its colour for RGB spectra; for
- * a LINE the linear sRGB of the line's XYZ exactly as the renderer's
- * spectral modes add it (Y = luminance of the tint), for a BLACKBODY the
- * linear sRGB of its spectrum integrated at 1 nm over the renderer's band
- * (Y = luminance of the tint); negative components (out-of-gamut
- * colours) clipped to 0. */
-static rs_color light_rgb(const rs_light *l)
-{
-    rs_spectrum s = l->spectrum;
-    double xyz[3] = { 0.0, 0.0, 0.0 };
-    rs_color c;
-
-    s.rgb = l->color;
-    switch (s.type) {
-    case RS_SPECTRUM_LINE:
-        rs_spectrum_line_xyz(&s, xyz);
-        break;
-    case RS_SPECTRUM_BLACKBODY: {
-        double norm = rs_spectrum_norm(&s);
-        int n = (int)(RS_LAMBDA_MAX - RS_LAMBDA_MIN);
-        for (int i = 0; i < n; i++) {
-            double lambda = RS_LAMBDA_MIN + i + 0.5;
-            rs_xyz_accumulate(xyz, rs_spectrum_emission_norm(&s, norm, lambda), lambda, 1.0);
-        }
-        break;
-    }
-    default:
-        return l->color;
-    }
-    rs_xyz_to_linear_srgb(xyz, &c);
-    return clamp_nonneg(c);
-}
 
 /* ---- objects ---------------------------------------------------------- */
 
@@ -792,19 +753,18 @@ static void box_add_xf(lp_vec3 *lo, lp_vec3 *hi, const rs_transform *xf, lp_vec3
 /* The farthest point where a primary ray meets a plane (0: none). */
 static double farthest_plane_hit(const rs_scene *scene, int width, int height)
 {
-    rs_view v;
     double far = 0.0;
     size_t n_planes = 0;
     for (size_t i = 0; i < scene->n_objects; i++)
         n_planes += scene->objects[i].type == RS_OBJ_PLANE;
     if (n_planes == 0)
         return 0.0;
-    if (rs_camera_setup(&scene->camera, width, height, &v, NULL, 0) != 0)
-        return INFINITY;
     for (int j = 0; j < height; j++)
         for (int i = 0; i < width; i++) {
             lp_vec3 o, d;
-            rs_camera_ray(&v, i + 0.5, j + 0.5, width, height, &o, &d);
+            if (lr_camera_ray(&scene->camera, width, height, i + 0.5, j + 0.5, &o, &d, NULL) !=
+                LR_OK)
+                return INFINITY;
             for (size_t k = 0; k < scene->n_objects; k++) {
                 const rs_object *ob = &scene->objects[k];
                 if (ob->type != RS_OBJ_PLANE)
@@ -1033,7 +993,7 @@ int pc_translate_scaled(const rs_scene *scene, const pc_translate_opts *opts, do
             fputs("light_source { ", out);
             put_vec(out, v3_scale(l->position, k));
             fputs(" color ", out);
-            put_rgb(out, light_rgb(l));
+            put_rgb(out, lr_light_rgb(l));
             fputs(" }\n", out);
         }
         if (scene->n_lights > 0)

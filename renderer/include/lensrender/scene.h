@@ -1,11 +1,15 @@
-/* scene.h -- the scene a .scene file describes (renderer-internal).
+/* scene.h -- the scene a .scene file describes: what lr_scene_description
+ * (lensrender/lensrender.h) shows of a loaded scene, and what the
+ * renderer itself renders from.
  *
- * The parser fills an rs_scene; the renderer reads it.  POV-Ray meaning
- * throughout: left-handed coordinates (x right, y up, z into the screen),
- * lengths in millimetres for lenses, colours linear RGB.  Transforms are
- * affine maps from object space to world space, composed in the order the
- * keywords appear (POV-Ray: each new transform applies after the ones
- * before it). */
+ * The reader fills an rs_scene and checks it (every rule once, with the
+ * place it was written); the renderer reads it.  A program using the face
+ * only reads a description: the functions at the end that build, prepare
+ * or change one are the renderer's own.  POV-Ray meaning throughout:
+ * left-handed coordinates (x right, y up, z into the screen), lengths in
+ * millimetres for lenses, colours linear RGB.  Transforms are affine maps
+ * from object space to world space, composed in the order the keywords
+ * appear (POV-Ray: each new transform applies after the ones before it). */
 #ifndef RS_SCENE_H
 #define RS_SCENE_H
 
