@@ -38,9 +38,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bvh.h"
 #include "camera.h"
 #include "coherence.h"
 #include "integrator.h"
+#include "packet.h"
 #include "shapes.h"
 #include "emitter.h"
 
@@ -74,17 +76,29 @@ struct rs_integrator {
     rs_color *light_rgb;        /* per light: its colour in the rgb mode (a
                                    line's or black body's own colour) */
     double correction[3][3];    /* C^-1: makes every RGB emitter exact */
+    band *lanes;                /* a pixel's bands: the rgb mode's three
+                                   channels, or the continuum wavelengths
+                                   then the lights' lines */
+    int n_lanes;
+    rs_lane_classes *classes;   /* lanes with equal optics per lens */
 };
 
 typedef struct frame {
     lp_backward *bw;
     bundle child;
     lp_result res;
+    /* A spectral packet's split at this level (n_lanes entries each). */
+    int *lane, *pos;
+    double *val, *acc;
+    unsigned char *done;
+    double *reach;  /* per light: light_reach memo of one shaded point */
 } frame;
 
 struct rs_worker {
     const rs_integrator *it;
     frame *frames[RS_MAX_FRAMES];
+    int *lane_all;       /* 0 .. n_lanes - 1 */
+    double *lane_value;  /* a pixel's value per lane */
     bundle pixel;
     rs_wavelets wavelets; /* of the band being traced (coherence.h) */
     uint64_t splits;      /* crystal lens hits, for rs_coherence_split */
@@ -144,6 +158,40 @@ static int invert3(const double a[3][3], double out[3][3])
             out[i][j] = (a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]) / det;
         }
     return 1;
+}
+
+/* The lanes of a pixel (see struct rs_integrator) and their classes. */
+static int make_lanes(rs_integrator *it)
+{
+    const rs_scene *sc = it->scene;
+    int n = it->opts.mode == RS_MODE_RGB ? 3 : it->opts.wavelengths;
+    if (it->opts.mode != RS_MODE_RGB)
+        for (size_t k = 0; k < sc->n_lights; k++)
+            n += sc->lights[k].spectrum.type == RS_SPECTRUM_LINE;
+    it->lanes = calloc((size_t)n, sizeof *it->lanes);
+    double *lambda = calloc((size_t)n, sizeof *lambda);
+    if (!it->lanes || !lambda) {
+        free(lambda);
+        return -1;
+    }
+    it->n_lanes = n;
+    if (it->opts.mode == RS_MODE_RGB) {
+        for (int c = 0; c < 3; c++)
+            it->lanes[c] = (band){BAND_RGB, RS_RGB_LAMBDA[c], -1, c};
+    } else {
+        int m = it->opts.wavelengths, k = 0;
+        double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / m;
+        for (; k < m; k++)
+            it->lanes[k] = (band){BAND_CONTINUUM, RS_LAMBDA_MIN + dl * (k + 0.5), -1, -1};
+        for (size_t l = 0; l < sc->n_lights; l++)
+            if (sc->lights[l].spectrum.type == RS_SPECTRUM_LINE)
+                it->lanes[k++] = (band){BAND_LINE, sc->lights[l].spectrum.line_nm, (int)l, -1};
+    }
+    for (int k = 0; k < n; k++)
+        lambda[k] = it->lanes[k].lambda;
+    int rc = rs_lane_classes_create(sc, lambda, n, &it->classes);
+    free(lambda);
+    return rc;
 }
 
 int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_integrator **out,
@@ -232,6 +280,11 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
             it->coherent[src_light(it, (int)k)] = 1;
             it->coherence[src_light(it, (int)k)] = scene->lights[k].coherence_length;
         }
+    if (make_lanes(it) != 0) {
+        rs_integrator_destroy(it);
+        snprintf(msg, msg_size, "out of memory");
+        return -1;
+    }
     *out = it;
     return 0;
 }
@@ -244,14 +297,25 @@ void rs_integrator_destroy(rs_integrator *it)
     free(it->coherence);
     free(it->light_norm);
     free(it->light_rgb);
+    free(it->lanes);
+    rs_lane_classes_destroy(it->classes);
     free(it);
 }
 
 rs_worker *rs_worker_create(const rs_integrator *it)
 {
     rs_worker *w = calloc(1, sizeof *w);
-    if (w)
-        w->it = it;
+    if (!w)
+        return NULL;
+    w->it = it;
+    w->lane_all = calloc((size_t)it->n_lanes, sizeof *w->lane_all);
+    w->lane_value = calloc((size_t)it->n_lanes, sizeof *w->lane_value);
+    if (!w->lane_all || !w->lane_value) {
+        rs_worker_destroy(w);
+        return NULL;
+    }
+    for (int k = 0; k < it->n_lanes; k++)
+        w->lane_all[k] = k;
     return w;
 }
 
@@ -265,8 +329,16 @@ void rs_worker_destroy(rs_worker *w)
         lp_backward_destroy(w->frames[f]->bw);
         free(w->frames[f]->child.r);
         lp_result_release(&w->frames[f]->res);
+        free(w->frames[f]->lane);
+        free(w->frames[f]->pos);
+        free(w->frames[f]->val);
+        free(w->frames[f]->acc);
+        free(w->frames[f]->done);
+        free(w->frames[f]->reach);
         free(w->frames[f]);
     }
+    free(w->lane_all);
+    free(w->lane_value);
     free(w->pixel.r);
     rs_wavelets_free(&w->wavelets);
     free(w);
@@ -278,9 +350,23 @@ static frame *get_frame(rs_worker *w, int f)
         return NULL;
     if (!w->frames[f]) {
         frame *fr = calloc(1, sizeof *fr);
+        size_t n = (size_t)w->it->n_lanes;
         if (!fr)
             return NULL;
-        if (lp_backward_create(&fr->bw, NULL) != LP_OK) {
+        fr->lane = calloc(n, sizeof *fr->lane);
+        fr->pos = calloc(n, sizeof *fr->pos);
+        fr->val = calloc(n, sizeof *fr->val);
+        fr->acc = calloc(n, sizeof *fr->acc);
+        fr->done = calloc(n, 1);
+        fr->reach = calloc(w->it->scene->n_lights + 1, sizeof *fr->reach);
+        if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach ||
+            lp_backward_create(&fr->bw, NULL) != LP_OK) {
+            free(fr->lane);
+            free(fr->pos);
+            free(fr->val);
+            free(fr->acc);
+            free(fr->done);
+            free(fr->reach);
             free(fr);
             return NULL;
         }
@@ -393,6 +479,44 @@ static int segment_meets_rim(const lp_lens *lens, lp_vec3 x, lp_vec3 d, double t
  * on its axis (Malus's law, the axis taken perpendicular to the segment,
  * as for camera rays); the unpolarized models pass half at each. */
 #define RS_SHADOW_POLARIZERS 16
+
+/* What the segment meets: the polarizers on it, sorted from the light
+ * (far end) towards x, equal distances in object order. */
+typedef struct shadow_seg {
+    const rs_scene *sc;
+    lp_vec3 x, d;
+    double eps, dist;
+    size_t pol[RS_SHADOW_POLARIZERS];
+    double tpol[RS_SHADOW_POLARIZERS];
+    int np;
+} shadow_seg;
+
+/* 1 when object i ends the segment (or it meets more polarizers than any
+ * stack of ideal polarizers needs); a polarizer it meets is recorded.
+ * The result does not depend on the order objects are offered in. */
+static int shadow_meets(void *ctx, int i)
+{
+    shadow_seg *s = ctx;
+    const rs_object *o = &s->sc->objects[i];
+    rs_hit h;
+    if (o->type == RS_OBJ_LENS)
+        return o->lens && segment_meets_rim(o->lens, s->x, s->d, s->eps, s->dist);
+    if (!rs_object_intersect(o, s->x, s->d, s->eps, s->dist, &h))
+        return 0;
+    if (o->type != RS_OBJ_POLARIZER || s->np == RS_SHADOW_POLARIZERS)
+        return 1;
+    int at = s->np++;
+    while (at > 0 && (s->tpol[at - 1] < h.t ||
+                      (s->tpol[at - 1] == h.t && s->pol[at - 1] > (size_t)i))) {
+        s->pol[at] = s->pol[at - 1];
+        s->tpol[at] = s->tpol[at - 1];
+        at--;
+    }
+    s->pol[at] = (size_t)i;
+    s->tpol[at] = h.t;
+    return 0;
+}
+
 static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
 {
     const rs_scene *sc = it->scene;
@@ -402,34 +526,23 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
     if (!(dist > 0.0))
         return 1.0;
     d = (lp_vec3){d.x / dist, d.y / dist, d.z / dist};
-    double eps = 1e-9 * (1.0 + sqrt(dot(x, x)));
-    size_t pol[RS_SHADOW_POLARIZERS];
-    double tpol[RS_SHADOW_POLARIZERS];
-    int np = 0;
-    for (size_t i = 0; i < sc->n_objects; i++) {
-        const rs_object *o = &sc->objects[i];
-        rs_hit h;
-        if (o->type == RS_OBJ_LENS) {
-            if (o->lens && segment_meets_rim(o->lens, x, d, eps, dist))
-                return 0.0;
-            continue;
-        }
-        if (!rs_object_intersect(o, x, d, eps, dist, &h))
-            continue;
-        if (o->type != RS_OBJ_POLARIZER)
-            return 0.0;
-        if (np == RS_SHADOW_POLARIZERS)
-            return 0.0; /* more than any stack of ideal polarizers needs */
-        /* keep them sorted from the light (far end) towards x */
-        int at = np++;
-        while (at > 0 && tpol[at - 1] < h.t) {
-            pol[at] = pol[at - 1];
-            tpol[at] = tpol[at - 1];
-            at--;
-        }
-        pol[at] = i;
-        tpol[at] = h.t;
-    }
+    shadow_seg sg;
+    sg.sc = sc;
+    sg.x = x;
+    sg.d = d;
+    sg.eps = 1e-9 * (1.0 + sqrt(dot(x, x)));
+    sg.dist = dist;
+    sg.np = 0;
+    int blocked = 0;
+    if (rs_bvh_serves(sc->bvh, sc))
+        blocked = rs_bvh_any(sc->bvh, x, d, sg.eps, dist, shadow_meets, &sg);
+    else
+        for (size_t i = 0; i < sc->n_objects && !blocked; i++)
+            blocked = shadow_meets(&sg, (int)i);
+    if (blocked)
+        return 0.0;
+    const size_t *pol = sg.pol;
+    int np = sg.np;
     if (np == 0)
         return 1.0;
     if (it->opts.mode != RS_MODE_POLARIZED)
@@ -490,8 +603,12 @@ static double highlight(const rs_finish *f, lp_vec3 n, lp_vec3 d, lp_vec3 l)
 
 /* Light leaving a surface towards the viewer along d, per source: emission,
  * ambient, and for each visible light diffuse (N.L)^brilliance plus the
- * highlights.  Calls emit(source, radiance) for each non-zero source. */
+ * highlights.  Calls emit(source, radiance) for each non-zero source.
+ * reach, when not NULL, holds light_reach of each light from this hit (NaN
+ * where not yet known): the lanes of a packet share their shadow rays
+ * through it. */
 static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_vec3 dir,
+                  double *reach,
                   emit_fn emit, void *ctx)
 {
     const rs_scene *sc = it->scene;
@@ -522,7 +639,13 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_ve
         double p = band_light(it, b, (int)k);
         if (p == 0.0)
             continue;
-        p *= light_reach(it, x, (int)k);
+        if (!reach)
+            p *= light_reach(it, x, (int)k);
+        else {
+            if (isnan(reach[k]))
+                reach[k] = light_reach(it, x, (int)k);
+            p *= reach[k];
+        }
         if (p == 0.0)
             continue;
         emit(ctx, src_light(it, (int)k), (diff + s) * p);
@@ -575,53 +698,108 @@ static void emit_sum(void *ctx, int source, double radiance)
     *(double *)ctx += radiance;
 }
 
-static double trace_scalar(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level,
-                           double weight, int skip, int f)
+/* The radiance of every lane of lane[0..n) (indices of it->lanes) seen
+ * along the ray, into out[0..n).  The lanes travel as one spectral packet
+ * (packet.h) and split at a lens where their optics differ; each lane's
+ * sums are formed in the same order as if it were traced alone. */
+static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
+                         double weight, int skip, int f, double *out)
 {
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
     rs_hit h;
 
-    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h))
-        return band_emission(b, sc->background);
+    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
+        for (int k = 0; k < n; k++)
+            out[k] = band_emission(&it->lanes[lane[k]], sc->background);
+        return;
+    }
+    for (int k = 0; k < n; k++)
+        out[k] = 0.0;
     const rs_object *ob = &sc->objects[h.object];
     if (ob->type == RS_OBJ_LENS) {
-        int dT = it->max_level - level;
+        int dT = it->max_level - level, m;
         frame *fr = get_frame(w, f);
         if (dT < 1 || !fr)
-            return 0.0;
+            return;
         lp_trace_args a;
         lp_trace_args_init(&a);
         a.mode = lens_mode(it);
         a.max_depth = dT < LP_MAX_DEPTH ? dT : LP_MAX_DEPTH;
         a.min_weight = weight > 0.0 ? it->cutoff / weight : INFINITY;
-        if (lp_backward_build(fr->bw, ob->lens, o, d, b->lambda, &a, NULL) != LP_OK)
-            return 0.0;
-        size_t nq = lp_backward_query_count(fr->bw);
-        const lp_query *q = lp_backward_queries(fr->bw);
-        double sum = 0.0;
-        for (size_t k = 0; k < nq; k++)
-            sum += q[k].weight * trace_scalar(w, b, q[k].origin, q[k].dir, level + q[k].depth,
-                                              weight * q[k].weight, -1, f + 1);
-        return sum;
+        memset(fr->done, 0, (size_t)n);
+        while ((m = rs_packet_next(it->classes, h.object, lane, n, fr->done, fr->pos)) > 0) {
+            for (int k = 0; k < m; k++)
+                fr->lane[k] = lane[fr->pos[k]];
+            if (lp_backward_build(fr->bw, ob->lens, o, d, it->lanes[fr->lane[0]].lambda, &a,
+                                  NULL) != LP_OK)
+                continue;
+            size_t nq = lp_backward_query_count(fr->bw);
+            const lp_query *q = lp_backward_queries(fr->bw);
+            for (int k = 0; k < m; k++)
+                fr->acc[k] = 0.0;
+            for (size_t j = 0; j < nq; j++) {
+                trace_scalar(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
+                             weight * q[j].weight, -1, f + 1, fr->val);
+                for (int k = 0; k < m; k++)
+                    fr->acc[k] += q[j].weight * fr->val[k];
+            }
+            for (int k = 0; k < m; k++)
+                out[fr->pos[k]] = fr->acc[k];
+        }
+        return;
     }
     if (ob->type == RS_OBJ_POLARIZER) {
         /* Natural light through an ideal polarizer: half of it. */
         if (f + 1 >= RS_MAX_FRAMES)
-            return 0.0;
-        return 0.5 * trace_scalar(w, b, h.point, d, level, 0.5 * weight, h.object, f + 1);
+            return;
+        trace_scalar(w, lane, n, h.point, d, level, 0.5 * weight, h.object, f + 1, out);
+        for (int k = 0; k < n; k++)
+            out[k] = 0.5 * out[k];
+        return;
     }
-    double sum = 0.0;
-    shade(it, b, &h, d, emit_sum, &sum);
-    if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES) {
-        double r = reflectivity(b, ob, &h, d);
-        if (r > 0.0 && weight * r >= it->cutoff) {
-            lp_vec3 rd = unit(madd(d, h.normal, -2.0 * dot(d, h.normal)));
-            lp_vec3 x = madd(h.point, h.normal, 1e-9 * (1.0 + sqrt(dot(h.point, h.point))));
-            sum += r * trace_scalar(w, b, x, rd, level + 1, weight * r, -1, f + 1);
+    frame *fr = get_frame(w, f);
+    if (fr)
+        for (size_t k = 0; k < sc->n_lights; k++)
+            fr->reach[k] = NAN;
+    for (int k = 0; k < n; k++)
+        shade(it, &it->lanes[lane[k]], &h, d, fr ? fr->reach : NULL, emit_sum, &out[k]);
+    if (!has_reflection(&ob->finish) || level >= it->max_level || f + 1 >= RS_MAX_FRAMES)
+        return;
+    lp_vec3 rd = unit(madd(d, h.normal, -2.0 * dot(d, h.normal)));
+    lp_vec3 x = madd(h.point, h.normal, 1e-9 * (1.0 + sqrt(dot(h.point, h.point))));
+    if (!fr) { /* no memory for the split: one lane at a time */
+        for (int k = 0; k < n; k++) {
+            double r = reflectivity(&it->lanes[lane[k]], ob, &h, d), v;
+            if (r > 0.0 && weight * r >= it->cutoff) {
+                trace_scalar(w, &lane[k], 1, x, rd, level + 1, weight * r, -1, f + 1, &v);
+                out[k] += r * v;
+            }
         }
+        return;
     }
-    return sum;
+    /* The mirror ray, shared by the lanes of equal reflectivity (they
+     * carry the same weight on). */
+    for (int k = 0; k < n; k++) {
+        double r = reflectivity(&it->lanes[lane[k]], ob, &h, d);
+        fr->val[k] = r;
+        fr->done[k] = !(r > 0.0 && weight * r >= it->cutoff);
+    }
+    for (int k = 0; k < n; k++) {
+        if (fr->done[k])
+            continue;
+        double r = fr->val[k];
+        int m = 0;
+        for (int j = k; j < n; j++)
+            if (!fr->done[j] && fr->val[j] == r) {
+                fr->done[j] = 1;
+                fr->pos[m] = j;
+                fr->lane[m++] = lane[j];
+            }
+        trace_scalar(w, fr->lane, m, x, rd, level + 1, weight * r, -1, f + 1, fr->acc);
+        for (int j = 0; j < m; j++)
+            out[fr->pos[j]] += r * fr->acc[j];
+    }
 }
 
 /* ---- the polarized mode: bundles ---- */
@@ -779,16 +957,15 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
     }
     emit_ctx e = {out, d, record_wavelet(w, o, d, &h)};
     if (e.wavelet >= 0)
-        shade(it, b, &h, d, emit_halves, &e);
+        shade(it, b, &h, d, NULL, emit_halves, &e);
     if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES)
         mirror_pol(w, b, ob, &h, d, level, weight, f, fr, out);
 }
 
+/* The polarized mode's power seen along a camera ray in one band. */
 static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
 {
     const rs_integrator *it = w->it;
-    if (it->opts.mode != RS_MODE_POLARIZED)
-        return trace_scalar(w, b, o, d, 1, 1.0, -1, 0);
     w->pixel.n = 0;
     w->wavelets.n = 0;
     trace_pol(w, b, o, d, 1, 1.0, -1, 0, &w->pixel);
@@ -799,39 +976,36 @@ static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
 /* Linear sRGB that the camera ray (o, d) brings. */
 static void ray_colour(const rs_integrator *it, rs_worker *w, lp_vec3 o, lp_vec3 d, rs_color *out)
 {
+    double *L = w->lane_value;
+
+    /* Every lane's value: the unpolarized modes trace them as one packet. */
+    if (it->opts.mode != RS_MODE_POLARIZED)
+        trace_scalar(w, w->lane_all, it->n_lanes, o, d, 1, 1.0, -1, 0, L);
+    else
+        for (int k = 0; k < it->n_lanes; k++)
+            L[k] = band_value(w, &it->lanes[k], o, d);
+
     if (it->opts.mode == RS_MODE_RGB) {
-        double v[3];
-        for (int c = 0; c < 3; c++) {
-            band b = {BAND_RGB, RS_RGB_LAMBDA[c], -1, c};
-            v[c] = band_value(w, &b, o, d);
-        }
-        *out = (rs_color){v[0], v[1], v[2]};
+        *out = (rs_color){L[0], L[1], L[2]};
         return;
     }
     double xyz[3] = {0, 0, 0}, lines[3] = {0, 0, 0}, cmf[3];
     int n = it->opts.wavelengths;
     double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
     for (int k = 0; k < n; k++) {
-        double lambda = RS_LAMBDA_MIN + dl * (k + 0.5);
-        band b = {BAND_CONTINUUM, lambda, -1, -1};
-        double L = band_value(w, &b, o, d);
-        rs_cmf(lambda, cmf);
+        rs_cmf(it->lanes[k].lambda, cmf);
         for (int c = 0; c < 3; c++)
-            xyz[c] += L * cmf[c] * dl;
+            xyz[c] += L[k] * cmf[c] * dl;
     }
     /* Lines are exact deltas: no quadrature, no correction. */
-    for (size_t k = 0; k < it->scene->n_lights; k++) {
-        const rs_light *l = &it->scene->lights[k];
-        if (l->spectrum.type != RS_SPECTRUM_LINE)
-            continue;
-        band b = {BAND_LINE, l->spectrum.line_nm, (int)k, -1};
-        double L = band_value(w, &b, o, d);
+    for (int k = n; k < it->n_lanes; k++) {
+        const rs_light *l = &it->scene->lights[it->lanes[k].light];
         double lx[3];
         rs_spectrum s = l->spectrum;
         s.rgb = l->color; /* the tint of the line */
         rs_spectrum_line_xyz(&s, lx);
         for (int c = 0; c < 3; c++)
-            lines[c] += L * lx[c];
+            lines[c] += L[k] * lx[c];
     }
     rs_color raw, rl;
     rs_xyz_to_linear_srgb(xyz, &raw);

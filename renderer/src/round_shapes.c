@@ -88,11 +88,11 @@ int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, do
         return 0;
     double sq = sqrt(disc);
     double lo = (-od - sq) / dd, hi = (-od + sq) / dd;
+    /* The samples span the sphere from t0 on, not cut at t1: the hit found
+     * does not depend on how near another object is. */
     if (lo < t0)
         lo = t0;
-    if (hi > t1)
-        hi = t1;
-    if (!(lo < hi))
+    if (!(lo < hi) || !(lo < t1))
         return 0;
     double a2 = dd, a1 = 2.0 * od, a0 = oo + R2 - r2;
     double b2 = d.x * d.x + d.z * d.z, b1 = 2.0 * (o.x * d.x + o.z * d.z),
@@ -120,6 +120,8 @@ int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, do
             double root = 0.5 * (a + b);
             if (!(root > t0))
                 root = b;
+            if (!(root < t1))
+                return 0;
             lp_vec3 p = madd(o, d, root);
             double g = dot(p, p) + R2 - r2;
             *t = root;

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bvh.h"
 #include "scene.h"
 
 void rs_scene_init(rs_scene *scene)
@@ -43,6 +44,7 @@ void rs_scene_init(rs_scene *scene)
     scene->lights = NULL;
     scene->files = NULL;
     scene->catalog = NULL;
+    scene->bvh = NULL;
 }
 
 void rs_scene_free(rs_scene *scene)
@@ -60,6 +62,7 @@ void rs_scene_free(rs_scene *scene)
         free(scene->messages[i].text);
     free(scene->messages);
     lp_catalog_destroy(scene->catalog);
+    rs_bvh_destroy(scene->bvh);
     rs_scene_init(scene);
 }
 
@@ -98,6 +101,19 @@ static int prep_error(char *msg, size_t msg_size, const rs_loc *loc, const char 
     return -1;
 }
 
+/* (Re)build the scene's bounding volume hierarchy. */
+static int build_bvh(rs_scene *scene, char *msg, size_t msg_size)
+{
+    rs_bvh_destroy(scene->bvh);
+    scene->bvh = NULL;
+    if (rs_bvh_build(scene, &scene->bvh) != 0) {
+        if (msg != NULL && msg_size > 0)
+            snprintf(msg, msg_size, "out of memory building the scene's bounding volumes");
+        return -1;
+    }
+    return 0;
+}
+
 /* Resolve catalog glass names and create every lens.  A lens created by
  * an earlier call is replaced, so the call may be repeated after the
  * descriptions change.  The catalog is created here when the caller has
@@ -132,7 +148,7 @@ int rs_scene_prepare(rs_scene *scene, char *msg, size_t msg_size)
             return prep_error(msg, msg_size, &o->loc, "lens: %s", err.message);
         }
     }
-    return 0;
+    return build_bvh(scene, msg, msg_size);
 }
 
 int rs_scene_freeze_glass(rs_scene *scene, double lambda_nm, char *msg, size_t msg_size)
@@ -170,5 +186,5 @@ int rs_scene_freeze_glass(rs_scene *scene, double lambda_nm, char *msg, size_t m
             return prep_error(msg, msg_size, &o->loc, "lens: %s", err.message);
         }
     }
-    return 0;
+    return build_bvh(scene, msg, msg_size);
 }

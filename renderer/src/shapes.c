@@ -8,6 +8,7 @@
  * placement in their parameters. */
 #include <math.h>
 
+#include "bvh.h"
 #include "round_shapes.h"
 #include "shapes.h"
 
@@ -197,6 +198,8 @@ int rs_scene_intersect(const rs_scene *scene, lp_vec3 origin, lp_vec3 dir, doubl
 {
     int found = 0;
     rs_hit h;
+    if (rs_bvh_serves(scene->bvh, scene))
+        return rs_bvh_intersect(scene->bvh, scene, origin, dir, t_min, t_max, skip, hit);
     for (size_t i = 0; i < scene->n_objects; i++) {
         if ((int)i == skip)
             continue;

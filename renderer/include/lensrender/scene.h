@@ -200,6 +200,9 @@ typedef struct rs_scene {
     rs_message *messages;   /* warnings and #debug text, in order */
     size_t n_messages;
     lp_catalog *catalog;    /* glasses for lenses */
+    struct rs_bvh *bvh;     /* acceleration structure over the objects,
+                               built by rs_scene_prepare (bvh.h); NULL
+                               before: intersections loop over objects */
 } rs_scene;
 
 /* Append a copy of text to the scene's messages.  0, or -1 (no memory). */
@@ -225,7 +228,9 @@ int rs_transform_scale(rs_transform *xf, lp_vec3 s);
 void rs_scene_init(rs_scene *scene);
 /* Free everything the scene owns (lenses, catalog, arrays). */
 void rs_scene_free(rs_scene *scene);
-/* Create the lensprim lenses of all lens objects (after parsing).
+/* Create the lensprim lenses of all lens objects (after parsing) and the
+ * bounding volume hierarchy over all objects; the objects must not change
+ * afterwards (call it again if they do).
  * Returns 0, or -1 with a message "file:line:col: ..." in msg. */
 int rs_scene_prepare(rs_scene *scene, char *msg, size_t msg_size);
 

@@ -1,0 +1,111 @@
+/* packet.c -- the lane classes of spectral packets (see packet.h). */
+#include <math.h>
+#include <stdlib.h>
+
+#include "packet.h"
+
+struct rs_lane_classes {
+    int n_lanes;
+    size_t n_objects;
+    int *cls;   /* [object * n_lanes + lane]; NULL rows for non-lenses */
+    unsigned char *is_lens;
+};
+
+typedef struct optics_key {
+    double n_glass, n_medium, alpha;
+    int covers;
+} optics_key;
+
+static optics_key key_at(const lp_lens_desc *d, double lambda)
+{
+    optics_key k;
+    k.n_glass = lp_glass_index(&d->glass, lambda);
+    k.n_medium = lp_glass_index(&d->medium, lambda);
+    k.alpha = lp_glass_absorption(&d->glass, lambda);
+    k.covers = lp_glass_covers(&d->glass, lambda) + 2 * lp_glass_covers(&d->medium, lambda);
+    return k;
+}
+
+/* Equal optics; a NaN equals nothing (such a lane stays alone). */
+static int same(const optics_key *a, const optics_key *b)
+{
+    return a->n_glass == b->n_glass && a->n_medium == b->n_medium && a->alpha == b->alpha &&
+           a->covers == b->covers;
+}
+
+int rs_lane_classes_create(const rs_scene *scene, const double *lambda, int n_lanes,
+                           rs_lane_classes **out)
+{
+    rs_lane_classes *c = calloc(1, sizeof *c);
+    optics_key *keys = calloc((size_t)(n_lanes > 0 ? n_lanes : 1), sizeof *keys);
+    size_t n = scene->n_objects;
+    *out = NULL;
+    if (!c || !keys)
+        goto fail;
+    c->n_lanes = n_lanes;
+    c->n_objects = n;
+    c->cls = calloc((n ? n : 1) * (size_t)(n_lanes > 0 ? n_lanes : 1), sizeof *c->cls);
+    c->is_lens = calloc(n ? n : 1, 1);
+    if (!c->cls || !c->is_lens)
+        goto fail;
+    for (size_t i = 0; i < n; i++) {
+        const rs_object *o = &scene->objects[i];
+        int *row = &c->cls[i * (size_t)n_lanes];
+        c->is_lens[i] = o->type == RS_OBJ_LENS && o->lens != NULL;
+        for (int k = 0; k < n_lanes; k++) {
+            row[k] = k;
+            if (!c->is_lens[i])
+                continue;
+            lp_lens_desc d;
+            lp_lens_get_desc(o->lens, &d);
+            if (d.uniaxial)
+                continue; /* a crystal's o and e indices: no sharing */
+            keys[k] = key_at(&d, lambda[k]);
+            for (int j = 0; j < k; j++)
+                if (row[j] == j && same(&keys[j], &keys[k])) {
+                    row[k] = j;
+                    break;
+                }
+        }
+    }
+    free(keys);
+    *out = c;
+    return 0;
+fail:
+    free(keys);
+    rs_lane_classes_destroy(c);
+    return -1;
+}
+
+void rs_lane_classes_destroy(rs_lane_classes *c)
+{
+    if (!c)
+        return;
+    free(c->cls);
+    free(c->is_lens);
+    free(c);
+}
+
+int rs_lane_class(const rs_lane_classes *c, int object, int lane)
+{
+    if (object < 0 || (size_t)object >= c->n_objects || lane < 0 || lane >= c->n_lanes)
+        return lane;
+    return c->cls[(size_t)object * (size_t)c->n_lanes + (size_t)lane];
+}
+
+int rs_packet_next(const rs_lane_classes *c, int object, const int *lane, int n,
+                   unsigned char *done, int *pos)
+{
+    int first = 0, m = 0;
+    while (first < n && done[first])
+        first++;
+    if (first == n)
+        return 0;
+    int cls = rs_lane_class(c, object, lane[first]);
+    for (int k = first; k < n; k++)
+        if (!done[k] && rs_lane_class(c, object, lane[k]) == cls) {
+            done[k] = 1;
+            pos[m++] = k;
+        }
+    return m;
+}
