@@ -106,23 +106,6 @@ static int vec_finite(lp_vec3 v)
     return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
 }
 
-static int color_finite(rs_color c)
-{
-    return isfinite(c.r) && isfinite(c.g) && isfinite(c.b);
-}
-
-static int xf_finite(const rs_transform *xf)
-{
-    for (int i = 0; i < 3; i++) {
-        if (!isfinite(xf->t[i]) || !isfinite(xf->inv_t[i]))
-            return 0;
-        for (int j = 0; j < 3; j++)
-            if (!isfinite(xf->m[i][j]) || !isfinite(xf->inv_m[i][j]))
-                return 0;
-    }
-    return 1;
-}
-
 static int xf_is_identity(const rs_transform *xf)
 {
     for (int i = 0; i < 3; i++) {
@@ -446,34 +429,6 @@ static void put_finish(FILE *out, const rs_finish *f)
     fputs(f->fresnel ? " fresnel on } }\n" : " } }\n", out);
 }
 
-static int check_object(const rs_object *o)
-{
-    if (!xf_finite(&o->xf) || !color_finite(o->pigment.color[0]) ||
-        !color_finite(o->pigment.color[1]) || !xf_finite(&o->pigment.to_pattern) ||
-        !color_finite(o->finish.ambient) || !color_finite(o->finish.emission) ||
-        !isfinite(o->finish.diffuse) || !isfinite(o->finish.brilliance) ||
-        !isfinite(o->finish.phong) || !isfinite(o->finish.phong_size) ||
-        !isfinite(o->finish.specular) || !isfinite(o->finish.roughness) ||
-        !color_finite(o->finish.reflection_min) || !color_finite(o->finish.reflection_max) ||
-        !isfinite(o->ior))
-        return -1;
-    switch (o->type) {
-    case RS_OBJ_PLANE:
-        return vec_finite(o->u.plane.normal) && isfinite(o->u.plane.distance) ? 0 : -1;
-    case RS_OBJ_SPHERE:
-        return vec_finite(o->u.sphere.center) && isfinite(o->u.sphere.radius) ? 0 : -1;
-    case RS_OBJ_BOX:
-        return vec_finite(o->u.box.corner1) && vec_finite(o->u.box.corner2) ? 0 : -1;
-    case RS_OBJ_DISC:
-        return vec_finite(o->u.disc.center) && vec_finite(o->u.disc.normal) &&
-                       isfinite(o->u.disc.radius) && isfinite(o->u.disc.hole)
-                   ? 0
-                   : -1;
-    default:
-        return 0;
-    }
-}
-
 /* A plane, sphere, box or disc with its pigment, finish and transform,
  * magnified k times. */
 static void put_shape(FILE *out, const rs_object *o, int turn, double k)
@@ -612,15 +567,6 @@ static int glass_absorbs(const lp_glass *g)
 
 /* ---- camera ------------------------------------------------------------- */
 
-static int camera_finite(const rs_camera *c)
-{
-    return vec_finite(c->location) && vec_finite(c->direction) && vec_finite(c->right) &&
-           vec_finite(c->up) && vec_finite(c->sky) && (!c->has_look_at || vec_finite(c->look_at)) &&
-           (!c->has_angle || isfinite(c->angle)) && (!c->has_xf || xf_finite(&c->xf));
-}
-
-/* The camera in a world magnified k times: points scale, directions do
- * not, and its transform M becomes S M S^-1 (translation times k). */
 static void put_camera(FILE *out, const rs_camera *c, double k)
 {
     /* POV-Ray applies these in its own fixed order (up, right, angle,
@@ -886,39 +832,21 @@ int pc_translate_scaled(const rs_scene *scene, const pc_translate_opts *opts, do
     if (!path_writable(inc))
         return fail(msg, msg_size, "the lens.inc path cannot be written in a POV-Ray string: %s",
                     inc);
-    if (!color_finite(scene->background) || !color_finite(scene->settings.ambient_light))
-        return fail(msg, msg_size, "background or ambient_light is not finite");
-    if (!camera_finite(&scene->camera))
-        return fail(msg, msg_size, "camera: a value is not finite");
+    lr_error check;
+    if (lr_scene_check(scene, &check) != LR_OK)
+        return fail(msg, msg_size, "%s", check.message);
     size_t n_lenses = 0;
     for (size_t i = 0; i < scene->n_objects; i++) {
         const rs_object *o = &scene->objects[i];
-        if (o->type == RS_OBJ_LENS) {
-            const lp_lens_desc *d = &o->u.lens.desc;
-            lp_error err;
-            lp_lens *tmp = NULL;
-            if (o->lens == NULL) { /* not prepared: check it here */
-                if (lp_lens_create(d, &tmp, &err) != LP_OK)
-                    return fail_at(msg, msg_size, &o->loc, err.message);
-                lp_lens_destroy(tmp);
-            } else if (!vec_finite(d->position) || !vec_finite(d->axis) ||
-                       !isfinite(d->thickness) || !isfinite(d->diameter) ||
-                       !isfinite(d->diameter2)) {
-                return fail_at(msg, msg_size, &o->loc, "lens: a value is not finite");
-            }
-            double ng = lp_glass_index(&d->glass, RS_LAMBDA_D_LINE);
-            double nm = lp_glass_index(&d->medium, RS_LAMBDA_D_LINE);
-            if (!isfinite(ng) || !isfinite(nm) || !(ng > 0.0) || !(nm > 0.0))
-                return fail_at(msg, msg_size, &o->loc, "lens: no index at the d line");
-            n_lenses++;
-        } else if (check_object(o) != 0) {
-            return fail_at(msg, msg_size, &o->loc, "a value is not finite");
-        }
+        if (o->type != RS_OBJ_LENS)
+            continue;
+        const lp_lens_desc *d = &o->u.lens.desc;
+        double ng = lp_glass_index(&d->glass, RS_LAMBDA_D_LINE);
+        double nm = lp_glass_index(&d->medium, RS_LAMBDA_D_LINE);
+        if (!isfinite(ng) || !isfinite(nm) || !(ng > 0.0) || !(nm > 0.0))
+            return fail_at(msg, msg_size, &o->loc, "lens: no index at the d line");
+        n_lenses++;
     }
-    for (size_t i = 0; i < scene->n_lights; i++)
-        if (!vec_finite(scene->lights[i].position) || !color_finite(scene->lights[i].color))
-            return fail_at(msg, msg_size, &scene->lights[i].loc,
-                           "light_source: a value is not finite");
 
     lp_vec3 eye = camera_location(&scene->camera);
     if (!mask) {

@@ -216,6 +216,16 @@ const rs_scene *lr_scene_description(const lr_scene *scene)
     return scene && scene->ok ? &scene->s : NULL;
 }
 
+lr_status lr_scene_check(const rs_scene *description, lr_error *err)
+{
+    char msg[MSG_MAX];
+    if (rs_scene_check(description, msg, sizeof msg) != 0)
+        return fail_located(err, LR_ERROR_SCENE, msg);
+    if (err)
+        memset(err, 0, sizeof *err);
+    return LR_OK;
+}
+
 lr_status lr_camera_ray(const rs_camera *camera, int width, int height, double px, double py,
                         lp_vec3 *origin, lp_vec3 *dir, lr_error *err)
 {

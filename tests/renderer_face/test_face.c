@@ -3,7 +3,8 @@
  * any other renderer header does not compile here).
  *
  * Loading: a scene with a lens loads, its warnings and #debug text come
- * back as messages in order; a wrong scene gives LR_ERROR_SCENE with the
+ * back as messages in order, it keeps the scene's rules (and a copy with a
+ * broken rule is refused at the object's place); a wrong scene gives LR_ERROR_SCENE with the
  * file, line and column where the error is; a missing file gives
  * LR_ERROR_IO with its path.  Options out of range are refused.
  * Determinism: the whole image on 1 thread, the whole image on 2 and 3
@@ -11,6 +12,7 @@
  * strips, an uneven grid, single pixels) rendered with 1, 2 and 3 threads
  * are byte for byte the same.  Progress: called, increasing, the last call
  * with done == total; a callback that says stop gives LR_CANCELLED. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -154,6 +156,29 @@ int main(void)
               strcmp(err.file, "<text>") == 0 && err.line == 2,
           "no_include: #include refused at <text>:2: '%s'", err.message);
     lr_scene_free(ms);
+
+    /* ---- the scene's rules, checked by one function ---- */
+    CHECK(lr_scene_check(lr_scene_description(scene), &err) == LR_OK,
+          "a loaded scene keeps the rules: %s", err.message);
+    {
+        const rs_scene *d = lr_scene_description(scene);
+        rs_scene copy = *d;
+        rs_object objs[3];
+        memcpy(objs, d->objects, sizeof objs);
+        copy.objects = objs;
+        objs[1].u.sphere.radius = -1.0; /* the sphere, written at line 9 */
+        CHECK(lr_scene_check(&copy, &err) == LR_ERROR_SCENE && strcmp(err.file, path) == 0 &&
+                  err.line == 9 && err.column == 1 && strstr(err.message, "radius"),
+              "a sphere of radius -1 breaks a rule at its place: %s", err.message);
+        objs[1].u.sphere.radius = 8.0;
+        objs[0].finish.roughness = NAN;
+        CHECK(lr_scene_check(&copy, &err) == LR_ERROR_SCENE && err.line == 8,
+              "a NaN roughness breaks a rule at the plane's line 8: %s", err.message);
+        objs[0].finish.roughness = d->objects[0].finish.roughness;
+        copy.camera.location.x = INFINITY;
+        CHECK(lr_scene_check(&copy, &err) == LR_ERROR_SCENE && strstr(err.message, "camera"),
+              "an infinite camera location breaks a rule: %s", err.message);
+    }
 
     /* ---- options ---- */
     lr_render_opts_init(&ro);

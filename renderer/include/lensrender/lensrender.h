@@ -157,6 +157,14 @@ const char *lr_scene_message(const lr_scene *scene, size_t k, lr_message_kind *k
  * scene that failed to load. */
 const rs_scene *lr_scene_description(const lr_scene *scene);
 
+/* The rules every scene description obeys (rs_scene_check in
+ * lensrender/scene.h: finite numbers, unit normals, positive sizes, lenses
+ * that can exist).  Every description lr_scene_load gives obeys them; a
+ * program that builds or changes a description calls this before using
+ * it.  Returns LR_OK, or LR_ERROR_SCENE with the first broken rule and,
+ * for an object or light, its file, line and column. */
+lr_status lr_scene_check(const rs_scene *description, lr_error *err);
+
 /* The primary ray through image point (px, py) (pixel centres at i + 0.5,
  * j + 0.5) of a width x height image, with POV-Ray's camera rules
  * (lensrender/scene.h): *origin, and *dir a unit vector.  Returns LR_OK,

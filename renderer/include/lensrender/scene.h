@@ -234,6 +234,18 @@ void rs_scene_free(rs_scene *scene);
  * Returns 0, or -1 with a message "file:line:col: ..." in msg. */
 int rs_scene_prepare(rs_scene *scene, char *msg, size_t msg_size);
 
+/* The rules every scene obeys, stated once: every number finite; plane,
+ * disc, polarizer normals, a polarizer's axis, a lens's axis and a
+ * polarized light's field unit vectors (to 1e-9); sphere, disc, cylinder,
+ * torus, polarizer radii > 0, cone radii >= 0, 0 <= a disc's hole <
+ * its radius; phong_size, roughness and ior > 0; a light's coherence
+ * length >= 0; every object placed in a file (line, column >= 1); a lens
+ * not yet created one that lp_lens_create accepts.  The reader builds only
+ * scenes that obey them (it refuses each broken rule where it is written);
+ * who builds or changes a scene otherwise calls this.  Returns 0, or -1
+ * with "FILE:LINE:COL: what" (or "camera: ..." and the like) in msg. */
+int rs_scene_check(const rs_scene *scene, char *msg, size_t msg_size);
+
 /* The helium d line (air wavelength), where catalogs quote n_d. */
 #define RS_LAMBDA_D_LINE 587.5618
 
