@@ -917,8 +917,8 @@ int main(int argc, char **argv)
     if (parse_args(argc, argv, &o) != 0)
         return EXIT_BAD;
     if (o.help) {
-        fputs(usage_text, stdout);
-        return fflush(stdout) == 0 ? 0 : EXIT_RENDER;
+        const char *text = usage_text;
+        return sp_print_text(&text, 1) == 0 ? 0 : EXIT_RENDER;
     }
     if (o.all)
         return compare_all(&o);

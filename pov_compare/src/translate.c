@@ -33,6 +33,7 @@
 #include <string.h>
 
 #include "lensrender/lensrender.h"
+#include "support/vec.h"
 
 #define PC_PI 3.14159265358979323846
 /* pc_pov_scale's largest factor.  Rays bent by a lens can travel far
@@ -101,11 +102,6 @@ static int fail_at(char *msg, size_t msg_size, const rs_loc *loc, const char *wh
     return fail(msg, msg_size, "%s", what);
 }
 
-static int vec_finite(lp_vec3 v)
-{
-    return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
-}
-
 static int xf_is_identity(const rs_transform *xf)
 {
     for (int i = 0; i < 3; i++) {
@@ -171,32 +167,6 @@ static void put_matrix(FILE *out, const rs_transform *xf, double k)
             fputs(", ", out);
     }
     fputc('>', out);
-}
-
-static lp_vec3 v3_scale(lp_vec3 v, double k)
-{
-    return (lp_vec3){ k * v.x, k * v.y, k * v.z };
-}
-
-static lp_vec3 v3_sub(lp_vec3 a, lp_vec3 b)
-{
-    return (lp_vec3){ a.x - b.x, a.y - b.y, a.z - b.z };
-}
-
-static double v3_dot(lp_vec3 a, lp_vec3 b)
-{
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-
-static lp_vec3 v3_cross(lp_vec3 a, lp_vec3 b)
-{
-    return (lp_vec3){ a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
-}
-
-static lp_vec3 v3_unit(lp_vec3 a)
-{
-    double l = sqrt(v3_dot(a, a));
-    return (lp_vec3){ a.x / l, a.y / l, a.z / l };
 }
 
 /* ---- lenses ------------------------------------------------------------- */
@@ -677,7 +647,7 @@ static int add_feature_notes(const rs_scene *sc, pc_notes *notes)
 /* Grow the box lo..hi by a point (non-finite points are ignored). */
 static void box_add(lp_vec3 *lo, lp_vec3 *hi, lp_vec3 p)
 {
-    if (!vec_finite(p))
+    if (!v3_finite(p))
         return;
     lo->x = fmin(lo->x, p.x);
     lo->y = fmin(lo->y, p.y);
