@@ -15,4 +15,9 @@ build/bin/lensrender scenes/crossed_polarizers.scene -o docs/images/crossed_pola
 # high interference orders need finer wavelength sampling than the default 16
 build/bin/lensrender scenes/michel_levy.scene -o docs/images/michel_levy.png \
     --width 320 --height 240 --wavelengths 64 --quiet
+# the polarizing microscope (its own directory: scenes/microscope/)
+for n in microscope microscope_empty; do
+    build/bin/lensrender "scenes/microscope/$n.scene" -o "docs/images/$n.png" \
+        --width 320 --height 240 --quiet
+done
 echo "render_examples: wrote docs/images/*.png"

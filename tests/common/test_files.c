@@ -6,6 +6,7 @@
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 double tf_now(void)
@@ -76,4 +77,13 @@ int tf_write(const char *path, const void *data, size_t len)
         return -1;
     ok = len == 0 || fwrite(data, 1, len, f) == len;
     return (fclose(f) == 0 && ok) ? 0 : -1;
+}
+
+int tf_is_png(const char *path)
+{
+    size_t n = 0;
+    char *d = tf_read(path, &n);
+    int ok = d && n > 8 && memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0;
+    free(d);
+    return ok;
 }

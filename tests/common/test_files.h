@@ -35,4 +35,8 @@ char *tf_read(const char *path, size_t *len);
  * otherwise (the file may then exist with part of the data). */
 int tf_write(const char *path, const void *data, size_t len);
 
+/* 1 when the file at `path` can be read and begins with the PNG
+ * signature, else 0. */
+int tf_is_png(const char *path);
+
 #endif

@@ -38,15 +38,6 @@ static int run(const char *prog, const char *const *args, tp_result *r)
     return 1;
 }
 
-static int is_png(const char *path)
-{
-    size_t n = 0;
-    char *d = tf_read(path, &n);
-    int ok = d && n > 8 && memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0;
-    free(d);
-    return ok;
-}
-
 /* N-BK7, Schott Sellmeier (catalog data), lambda in um */
 static double n_bk7(double um)
 {
@@ -126,7 +117,7 @@ int main(void)
                           "shares.png", "rgb_vs_spectral.png", "schlick_vs_g.png"};
     for (size_t i = 0; i < sizeof figs / sizeof figs[0]; i++) {
         snprintf(path, sizeof path, "%s/%s", out, figs[i]);
-        CHECK(is_png(path), "%s is a PNG", path);
+        CHECK(tf_is_png(path), "%s is a PNG", path);
     }
     snprintf(path, sizeof path, "%s/cone.csv", out);
     char *csv = tf_read(path, &n);
