@@ -5,33 +5,17 @@
 #include <stdio.h>
 
 #include "lensrender/scene.h"
-
-static int fin(lp_vec3 v)
-{
-    return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
-}
+#include "support/vec.h"
 
 /* Unit to 1e-9 in the squared length. */
 static int unit(lp_vec3 v)
 {
-    return fin(v) && fabs(v.x * v.x + v.y * v.y + v.z * v.z - 1.0) < 1e-9;
+    return v3_finite(v) && fabs(v.x * v.x + v.y * v.y + v.z * v.z - 1.0) < 1e-9;
 }
 
 static int color_fin(rs_color c)
 {
     return isfinite(c.r) && isfinite(c.g) && isfinite(c.b);
-}
-
-static int xf_fin(const rs_transform *xf)
-{
-    for (int i = 0; i < 3; i++) {
-        if (!isfinite(xf->t[i]) || !isfinite(xf->inv_t[i]))
-            return 0;
-        for (int j = 0; j < 3; j++)
-            if (!isfinite(xf->m[i][j]) || !isfinite(xf->inv_m[i][j]))
-                return 0;
-    }
-    return 1;
 }
 
 static int broken(char *msg, size_t msg_size, const rs_loc *loc, const char *fmt, ...)
@@ -69,16 +53,16 @@ static const char *shape_problem(const rs_object *o)
                    ? NULL
                    : "plane: the normal must be a finite unit vector, the distance finite";
     case RS_OBJ_SPHERE:
-        return fin(o->u.sphere.center) && isfinite(o->u.sphere.radius) &&
+        return v3_finite(o->u.sphere.center) && isfinite(o->u.sphere.radius) &&
                        o->u.sphere.radius > 0.0
                    ? NULL
                    : "sphere: the centre must be finite, the radius finite and > 0";
     case RS_OBJ_BOX:
-        return fin(o->u.box.corner1) && fin(o->u.box.corner2)
+        return v3_finite(o->u.box.corner1) && v3_finite(o->u.box.corner2)
                    ? NULL
                    : "box: the corners must be finite";
     case RS_OBJ_DISC:
-        return fin(o->u.disc.center) && unit(o->u.disc.normal) &&
+        return v3_finite(o->u.disc.center) && unit(o->u.disc.normal) &&
                        isfinite(o->u.disc.radius) && o->u.disc.radius > 0.0 &&
                        o->u.disc.hole >= 0.0 && o->u.disc.hole < o->u.disc.radius
                    ? NULL
@@ -86,25 +70,25 @@ static const char *shape_problem(const rs_object *o)
     case RS_OBJ_LENS: {
         const lp_lens_desc *d = &o->u.lens.desc;
         return !isnan(d->radius1) && !isnan(d->radius2) && isfinite(d->thickness) &&
-                       isfinite(d->diameter) && isfinite(d->diameter2) && fin(d->position) &&
+                       isfinite(d->diameter) && isfinite(d->diameter2) && v3_finite(d->position) &&
                        unit(d->axis)
                    ? NULL
                    : "lens: radii must be numbers, thickness, diameters and position "
                      "finite, the axis a unit vector";
     }
     case RS_OBJ_POLARIZER:
-        return fin(o->u.polarizer.center) && unit(o->u.polarizer.normal) &&
+        return v3_finite(o->u.polarizer.center) && unit(o->u.polarizer.normal) &&
                        unit(o->u.polarizer.axis) && isfinite(o->u.polarizer.radius) &&
                        o->u.polarizer.radius > 0.0
                    ? NULL
                    : "polarizer: centre finite, unit normal and axis, radius > 0";
     case RS_OBJ_CYLINDER:
-        return fin(o->u.cylinder.base) && fin(o->u.cylinder.cap) &&
+        return v3_finite(o->u.cylinder.base) && v3_finite(o->u.cylinder.cap) &&
                        isfinite(o->u.cylinder.radius) && o->u.cylinder.radius > 0.0
                    ? NULL
                    : "cylinder: ends finite, radius > 0";
     case RS_OBJ_CONE:
-        return fin(o->u.cone.base) && fin(o->u.cone.cap) && isfinite(o->u.cone.base_radius) &&
+        return v3_finite(o->u.cone.base) && v3_finite(o->u.cone.cap) && isfinite(o->u.cone.base_radius) &&
                        isfinite(o->u.cone.cap_radius) && o->u.cone.base_radius >= 0.0 &&
                        o->u.cone.cap_radius >= 0.0
                    ? NULL
@@ -130,7 +114,7 @@ int rs_scene_check(const rs_scene *s, char *msg, size_t msg_size)
         lp_error err;
         if (o->loc.line < 1 || o->loc.column < 1)
             return broken(msg, msg_size, NULL, "object %zu has no place in a file", i);
-        if (!xf_fin(&o->xf) || !xf_fin(&o->pigment.to_pattern))
+        if (!rs_transform_finite(&o->xf) || !rs_transform_finite(&o->pigment.to_pattern))
             return broken(msg, msg_size, &o->loc, "a transform is not finite");
         if (!color_fin(o->pigment.color[0]) || !color_fin(o->pigment.color[1]))
             return broken(msg, msg_size, &o->loc, "a pigment colour is not finite");
@@ -151,16 +135,16 @@ int rs_scene_check(const rs_scene *s, char *msg, size_t msg_size)
     }
     for (size_t i = 0; i < s->n_lights; i++) {
         const rs_light *l = &s->lights[i];
-        if (!fin(l->position) || !color_fin(l->color) || (l->polarized && !unit(l->polarization)) ||
+        if (!v3_finite(l->position) || !color_fin(l->color) || (l->polarized && !unit(l->polarization)) ||
             !isfinite(l->coherence_length) || l->coherence_length < 0.0)
             return broken(msg, msg_size, &l->loc,
                           "light_source: position and colour finite, polarization a unit "
                           "vector, coherence length finite and >= 0");
     }
     const rs_camera *c = &s->camera;
-    if (!fin(c->location) || !fin(c->direction) || !fin(c->right) || !fin(c->up) ||
-        !fin(c->sky) || (c->has_look_at && !fin(c->look_at)) ||
-        (c->has_angle && !isfinite(c->angle)) || !xf_fin(&c->xf) || !fin(c->focal_point) ||
+    if (!v3_finite(c->location) || !v3_finite(c->direction) || !v3_finite(c->right) || !v3_finite(c->up) ||
+        !v3_finite(c->sky) || (c->has_look_at && !v3_finite(c->look_at)) ||
+        (c->has_angle && !isfinite(c->angle)) || !rs_transform_finite(&c->xf) || !v3_finite(c->focal_point) ||
         !isfinite(c->aperture))
         return broken(msg, msg_size, NULL, "camera: a value is not finite");
     if (!color_fin(s->background) || !color_fin(s->settings.ambient_light))

@@ -224,6 +224,8 @@ void rs_transform_compose(const rs_transform *a, const rs_transform *b, rs_trans
 int rs_transform_translate(rs_transform *xf, lp_vec3 v);
 int rs_transform_rotate(rs_transform *xf, lp_vec3 degrees);
 int rs_transform_scale(rs_transform *xf, lp_vec3 s);
+/* Nonzero when every number of the transform and of its inverse is finite. */
+int rs_transform_finite(const rs_transform *xf);
 
 void rs_scene_init(rs_scene *scene);
 /* Free everything the scene owns (lenses, catalog, arrays). */
