@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "bvh.h"
+#include "csg.h"
 
 typedef struct bvh_node {
     double lo[3], hi[3];
@@ -106,6 +107,12 @@ int rs_object_bounds(const rs_object *o, lp_vec3 *lo_out, lp_vec3 *hi_out)
         if (!o->lens)
             return 0;
         lp_lens_bounds(o->lens, &a, &b);
+        lo[0] = a.x, lo[1] = a.y, lo[2] = a.z;
+        hi[0] = b.x, hi[1] = b.y, hi[2] = b.z;
+        break;
+    case RS_OBJ_CSG: /* from its members' boxes (csg.h) */
+        if (!rs_csg_bounds(o, rs_object_bounds, &a, &b))
+            return 0;
         lo[0] = a.x, lo[1] = a.y, lo[2] = a.z;
         hi[0] = b.x, hi[1] = b.y, hi[2] = b.z;
         break;

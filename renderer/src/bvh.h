@@ -2,7 +2,7 @@
  * (renderer-internal).
  *
  * Objects with a finite world bounding box (spheres, boxes, discs,
- * cylinders, cones, tori, lenses, polarizers) go into a binary tree of
+ * cylinders, cones, tori, lenses, polarizers, CSG objects) go into a binary tree of
  * axis-aligned boxes split at the median of their centres along the
  * widest axis, at most RS_BVH_LEAF objects per leaf; every other object (planes, and any kind
  * of object this file does not know a bound for) is tried for every ray.

@@ -58,8 +58,11 @@ typedef struct band {
     int channel;    /* BAND_RGB */
 } band;
 
+/* Rays of the polarized mode; lane[i] is the lane (index of it->lanes)
+ * ray i belongs to: a packet's bundle holds every lane's rays. */
 typedef struct bundle {
     lp_ray *r;
+    int *lane;
     size_t n, cap;
 } bundle;
 
@@ -86,6 +89,7 @@ struct rs_integrator {
 typedef struct frame {
     lp_backward *bw;
     bundle child;
+    bundle one;     /* the rays of one lane of child */
     lp_result res;
     /* A spectral packet's split at this level (n_lanes entries each). */
     int *lane, *pos;
@@ -100,6 +104,7 @@ struct rs_worker {
     int *lane_all;       /* 0 .. n_lanes - 1 */
     double *lane_value;  /* a pixel's value per lane */
     bundle pixel;
+    bundle one;          /* the rays of one lane of pixel */
     rs_wavelets wavelets; /* of the band being traced (coherence.h) */
     uint64_t splits;      /* crystal lens hits, for rs_coherence_split */
 };
@@ -328,6 +333,9 @@ void rs_worker_destroy(rs_worker *w)
             continue;
         lp_backward_destroy(w->frames[f]->bw);
         free(w->frames[f]->child.r);
+        free(w->frames[f]->child.lane);
+        free(w->frames[f]->one.r);
+        free(w->frames[f]->one.lane);
         lp_result_release(&w->frames[f]->res);
         free(w->frames[f]->lane);
         free(w->frames[f]->pos);
@@ -340,6 +348,9 @@ void rs_worker_destroy(rs_worker *w)
     free(w->lane_all);
     free(w->lane_value);
     free(w->pixel.r);
+    free(w->pixel.lane);
+    free(w->one.r);
+    free(w->one.lane);
     rs_wavelets_free(&w->wavelets);
     free(w);
 }
@@ -376,7 +387,8 @@ static frame *get_frame(rs_worker *w, int f)
     return w->frames[f];
 }
 
-static lp_ray *bundle_push(bundle *b)
+/* A new ray of lane `lane` at the end of b (NULL when out of memory). */
+static lp_ray *bundle_push(bundle *b, int lane)
 {
     if (b->n == b->cap) {
         size_t cap = b->cap ? 2 * b->cap : 16;
@@ -384,9 +396,28 @@ static lp_ray *bundle_push(bundle *b)
         if (!r)
             return NULL;
         b->r = r;
+        int *l = realloc(b->lane, cap * sizeof *l);
+        if (!l)
+            return NULL;
+        b->lane = l;
         b->cap = cap;
     }
+    b->lane[b->n] = lane;
     return &b->r[b->n++];
+}
+
+/* one = the rays of lane `lane` in b, in b's order; -1 when out of memory. */
+static int bundle_select(const bundle *b, int lane, bundle *one)
+{
+    one->n = 0;
+    for (size_t i = 0; i < b->n; i++)
+        if (b->lane[i] == lane) {
+            lp_ray *r = bundle_push(one, lane);
+            if (!r)
+                return -1;
+            *r = b->r[i];
+        }
+    return 0;
 }
 
 /* ---- small vector helpers ---- */
@@ -612,7 +643,7 @@ static void shade(const rs_integrator *it, const band *b, const rs_hit *h, lp_ve
                   emit_fn emit, void *ctx)
 {
     const rs_scene *sc = it->scene;
-    const rs_object *o = &sc->objects[h->object];
+    const rs_object *o = h->surface;
     const rs_finish *f = &o->finish;
     rs_color pig = pigment_at(&o->pigment, h->point);
     double e = band_emission(b, mul(pig, f->emission));
@@ -716,7 +747,7 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     }
     for (int k = 0; k < n; k++)
         out[k] = 0.0;
-    const rs_object *ob = &sc->objects[h.object];
+    const rs_object *ob = h.surface;
     if (ob->type == RS_OBJ_LENS) {
         int dT = it->max_level - level, m;
         frame *fr = get_frame(w, f);
@@ -808,6 +839,7 @@ typedef struct emit_ctx {
     bundle *out;
     lp_vec3 d;
     long wavelet; /* its index in the worker's table */
+    int lane;
 } emit_ctx;
 
 /* Natural light of one source as two orthogonal incoherent halves. */
@@ -817,7 +849,7 @@ static void emit_halves(void *ctx, int source, double radiance)
     lp_vec3 h = fabs(e->d.y) < 0.9 ? (lp_vec3){0, 1, 0} : (lp_vec3){1, 0, 0};
     lp_vec3 v1 = unit(cross(e->d, h)), v2 = cross(e->d, v1);
     for (int half = 0; half < 2; half++) {
-        lp_ray *r = bundle_push(e->out);
+        lp_ray *r = bundle_push(e->out, e->lane);
         if (!r)
             return;
         memset(r, 0, sizeof *r);
@@ -843,38 +875,58 @@ static long record_wavelet(rs_worker *w, lp_vec3 o, lp_vec3 d, const rs_hit *h)
     return rs_wavelets_push(&w->wavelets, &wl);
 }
 
-static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
-                      int skip, int f, bundle *out);
+static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
+                      double weight, int skip, int f, bundle *out);
 
 /* A mirror reflection in the polarized mode: the bundle seen along the
  * mirror direction, scaled by the reflectivity, each field mirrored
  * (Householder) with a pi jump (an ideal conductor reverses the tangential
- * field), its optical path referred to the origin of the ray along d. */
-static void mirror_pol(rs_worker *w, const band *b, const rs_object *ob, const rs_hit *h,
-                       lp_vec3 d, int level, double weight, int f, frame *fr, bundle *out)
+ * field), its optical path referred to the origin of the ray along d.
+ * Lanes of equal reflectivity share the mirror ray. */
+static void mirror_pol(rs_worker *w, const int *lane, int n, const rs_object *ob,
+                       const rs_hit *h, lp_vec3 d, int level, double weight, int f, frame *fr,
+                       bundle *out)
 {
-    double r = reflectivity(b, ob, h, d);
-    if (!(r > 0.0) || weight * r < w->it->cutoff)
-        return;
-    lp_vec3 n = h->normal;
-    lp_vec3 rd = unit(madd(d, n, -2.0 * dot(d, n)));
-    lp_vec3 x = madd(h->point, n, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
-    fr->child.n = 0;
-    trace_pol(w, b, x, rd, level + 1, weight * r, -1, f + 1, &fr->child);
-    for (size_t i = 0; i < fr->child.n; i++) {
-        lp_ray *p = bundle_push(out);
-        if (!p)
-            return;
-        *p = fr->child.r[i];
-        p->intensity *= r;
-        p->vp = madd(p->vp, n, -2.0 * dot(p->vp, n));
-        p->kphi += 1;
-        p->op += h->t;
+    const rs_integrator *it = w->it;
+    lp_vec3 nv = h->normal;
+    lp_vec3 rd = unit(madd(d, nv, -2.0 * dot(d, nv)));
+    lp_vec3 x = madd(h->point, nv, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
+    for (int k = 0; k < n; k++) {
+        double r = reflectivity(&it->lanes[lane[k]], ob, h, d);
+        fr->val[k] = r;
+        fr->done[k] = !(r > 0.0) || weight * r < it->cutoff;
+    }
+    for (int k = 0; k < n; k++) {
+        if (fr->done[k])
+            continue;
+        double r = fr->val[k];
+        int m = 0;
+        for (int j = k; j < n; j++)
+            if (!fr->done[j] && fr->val[j] == r) {
+                fr->done[j] = 1;
+                fr->lane[m++] = lane[j];
+            }
+        fr->child.n = 0;
+        trace_pol(w, fr->lane, m, x, rd, level + 1, weight * r, -1, f + 1, &fr->child);
+        for (size_t i = 0; i < fr->child.n; i++) {
+            lp_ray *p = bundle_push(out, fr->child.lane[i]);
+            if (!p)
+                return;
+            *p = fr->child.r[i];
+            p->intensity *= r;
+            p->vp = madd(p->vp, nv, -2.0 * dot(p->vp, nv));
+            p->kphi += 1;
+            p->op += h->t;
+        }
     }
 }
 
-static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int level, double weight,
-                      int skip, int f, bundle *out)
+/* The bundles of lanes lane[0..n) seen along the ray, appended to out,
+ * each ray tagged with its lane.  The lanes travel as one packet and
+ * split at a lens where their optics differ, as in trace_scalar; the rays
+ * of one lane are those, in the same order, that tracing it alone gives. */
+static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
+                      double weight, int skip, int f, bundle *out)
 {
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
@@ -882,21 +934,25 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
     size_t start = out->n;
 
     if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
-        double L = band_emission(b, sc->background);
-        if (L == 0.0)
-            return;
-        emit_ctx e = {out, d, record_wavelet(w, o, d, NULL)};
-        if (e.wavelet >= 0)
+        emit_ctx e = {out, d, -1, 0};
+        for (int k = 0; k < n; k++) {
+            double L = band_emission(&it->lanes[lane[k]], sc->background);
+            if (L == 0.0)
+                continue;
+            if (e.wavelet < 0 && (e.wavelet = record_wavelet(w, o, d, NULL)) < 0)
+                return;
+            e.lane = lane[k];
             emit_halves(&e, 1, L);
+        }
         return;
     }
-    const rs_object *ob = &sc->objects[h.object];
+    const rs_object *ob = h.surface;
     frame *fr = get_frame(w, f);
     if (!fr)
         return;
 
     if (ob->type == RS_OBJ_LENS) {
-        int dT = it->max_level - level;
+        int dT = it->max_level - level, m;
         if (dT < 1)
             return;
         lp_trace_args a;
@@ -904,28 +960,43 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
         a.mode = LP_MODE_POLARIZED;
         a.max_depth = dT < LP_MAX_DEPTH ? dT : LP_MAX_DEPTH;
         a.min_weight = weight > 0.0 ? it->cutoff / weight : INFINITY;
-        if (lp_backward_build(fr->bw, ob->lens, o, d, b->lambda, &a, NULL) != LP_OK)
-            return;
-        size_t nq = lp_backward_query_count(fr->bw);
-        const lp_query *q = lp_backward_queries(fr->bw);
-        uint64_t hit = ++w->splits;
-        for (size_t k = 0; k < nq; k++) {
-            fr->child.n = 0;
-            trace_pol(w, b, q[k].origin, q[k].dir, level + q[k].depth, weight * q[k].bound, -1,
-                      f + 1, &fr->child);
-            if (fr->child.n == 0)
+        int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
+        memset(fr->done, 0, (size_t)n);
+        while ((m = rs_packet_next(it->classes, h.object, lane, n, fr->done, fr->pos)) > 0) {
+            for (int k = 0; k < m; k++)
+                fr->lane[k] = lane[fr->pos[k]];
+            if (lp_backward_build(fr->bw, ob->lens, o, d, it->lanes[fr->lane[0]].lambda, &a,
+                                  NULL) != LP_OK)
                 continue;
-            lp_result_clear(&fr->res);
-            if (lp_backward_gather(fr->bw, k, fr->child.r, fr->child.n, &fr->res, NULL) != LP_OK)
-                continue;
-            int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
-            for (size_t i = 0; i < fr->res.count; i++) {
-                lp_ray *r = bundle_push(out);
-                if (!r)
-                    return;
-                *r = fr->res.rays[i].ray;
-                if (split)
-                    r->ch = rs_coherence_split(r->ch, hit, q[k].depth, q[k].kind != LP_KIND_REFLECT);
+            size_t nq = lp_backward_query_count(fr->bw);
+            const lp_query *q = lp_backward_queries(fr->bw);
+            uint64_t hit = ++w->splits;
+            for (size_t j = 0; j < nq; j++) {
+                fr->child.n = 0;
+                trace_pol(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
+                          weight * q[j].bound, -1, f + 1, &fr->child);
+                for (int k = 0; k < m && fr->child.n > 0; k++) {
+                    const bundle *one = &fr->child;
+                    if (m > 1) { /* this lane's rays alone */
+                        if (bundle_select(&fr->child, fr->lane[k], &fr->one) != 0)
+                            return;
+                        one = &fr->one;
+                    }
+                    if (one->n == 0)
+                        continue;
+                    lp_result_clear(&fr->res);
+                    if (lp_backward_gather(fr->bw, j, one->r, one->n, &fr->res, NULL) != LP_OK)
+                        continue;
+                    for (size_t i = 0; i < fr->res.count; i++) {
+                        lp_ray *r = bundle_push(out, fr->lane[k]);
+                        if (!r)
+                            return;
+                        *r = fr->res.rays[i].ray;
+                        if (split)
+                            r->ch = rs_coherence_split(r->ch, hit, q[j].depth,
+                                                       q[j].kind != LP_KIND_REFLECT);
+                    }
+                }
             }
         }
         shift_op(out, start, h.t);
@@ -935,7 +1006,7 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
         if (f + 1 >= RS_MAX_FRAMES)
             return;
         fr->child.n = 0;
-        trace_pol(w, b, h.point, d, level, weight, h.object, f + 1, &fr->child);
+        trace_pol(w, lane, n, h.point, d, level, weight, h.object, f + 1, &fr->child);
         lp_vec3 ax = ob->u.polarizer.axis;
         ax = unit(madd(ax, d, -dot(ax, d)));
         for (size_t i = 0; i < fr->child.n; i++) {
@@ -947,7 +1018,7 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
             r.vp = ax;
             if (c < 0.0)
                 r.kphi += 1; /* the field now points along -axis */
-            lp_ray *p = bundle_push(out);
+            lp_ray *p = bundle_push(out, fr->child.lane[i]);
             if (!p)
                 return;
             *p = r;
@@ -955,22 +1026,40 @@ static void trace_pol(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d, int lev
         shift_op(out, start, h.t);
         return;
     }
-    emit_ctx e = {out, d, record_wavelet(w, o, d, &h)};
-    if (e.wavelet >= 0)
-        shade(it, b, &h, d, NULL, emit_halves, &e);
+    emit_ctx e = {out, d, record_wavelet(w, o, d, &h), 0};
+    if (e.wavelet >= 0) {
+        for (size_t k = 0; k < sc->n_lights; k++)
+            fr->reach[k] = NAN;
+        for (int k = 0; k < n; k++) {
+            e.lane = lane[k];
+            shade(it, &it->lanes[lane[k]], &h, d, fr->reach, emit_halves, &e);
+        }
+    }
     if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES)
-        mirror_pol(w, b, ob, &h, d, level, weight, f, fr, out);
+        mirror_pol(w, lane, n, ob, &h, d, level, weight, f, fr, out);
 }
 
-/* The polarized mode's power seen along a camera ray in one band. */
-static double band_value(rs_worker *w, const band *b, lp_vec3 o, lp_vec3 d)
+/* The polarized mode's power seen along a camera ray in every lane, into
+ * L[0..n_lanes): the lanes traced as one packet, each lane's power from
+ * its own rays. */
+static void pol_values(rs_worker *w, lp_vec3 o, lp_vec3 d, double *L)
 {
     const rs_integrator *it = w->it;
     w->pixel.n = 0;
     w->wavelets.n = 0;
-    trace_pol(w, b, o, d, 1, 1.0, -1, 0, &w->pixel);
-    return rs_coherent_power(w->pixel.r, w->pixel.n, &w->wavelets, it->coherent, it->coherence,
-                             it->n_sources, b->lambda);
+    trace_pol(w, w->lane_all, it->n_lanes, o, d, 1, 1.0, -1, 0, &w->pixel);
+    for (int k = 0; k < it->n_lanes; k++) {
+        const bundle *one = &w->pixel;
+        if (it->n_lanes > 1) {
+            if (bundle_select(&w->pixel, k, &w->one) != 0) {
+                L[k] = 0.0;
+                continue;
+            }
+            one = &w->one;
+        }
+        L[k] = rs_coherent_power(one->r, one->n, &w->wavelets, it->coherent, it->coherence,
+                                 it->n_sources, it->lanes[k].lambda);
+    }
 }
 
 /* Linear sRGB that the camera ray (o, d) brings. */
@@ -978,12 +1067,11 @@ static void ray_colour(const rs_integrator *it, rs_worker *w, lp_vec3 o, lp_vec3
 {
     double *L = w->lane_value;
 
-    /* Every lane's value: the unpolarized modes trace them as one packet. */
+    /* Every lane's value: the lanes are traced as one packet. */
     if (it->opts.mode != RS_MODE_POLARIZED)
         trace_scalar(w, w->lane_all, it->n_lanes, o, d, 1, 1.0, -1, 0, L);
     else
-        for (int k = 0; k < it->n_lanes; k++)
-            L[k] = band_value(w, &it->lanes[k], o, d);
+        pol_values(w, o, d, L);
 
     if (it->opts.mode == RS_MODE_RGB) {
         *out = (rs_color){L[0], L[1], L[2]};

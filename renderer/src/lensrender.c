@@ -11,6 +11,7 @@
 
 #include "auto_settings.h"
 #include "camera.h"
+#include "csg.h"
 #include "emitter.h"
 #include "integrator.h"
 #include "library_path.h"
@@ -237,6 +238,11 @@ lr_status lr_camera_ray(const rs_camera *camera, int width, int height, double p
         return fail(err, LR_ERROR_CAMERA, "%s%s", msg, NULL);
     rs_camera_ray(&v, px, py, width, height, origin, dir);
     return LR_OK;
+}
+
+int lr_object_inside(const rs_object *object, lp_vec3 p)
+{
+    return rs_object_inside(object, p);
 }
 
 static rs_color clamp_nonneg(rs_color c)

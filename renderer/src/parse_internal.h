@@ -122,6 +122,8 @@ typedef struct parser {
     const char *file;       /* the current frame's file (for locations) */
     double image_width, image_height;
     size_t max_objects;
+    size_t csg_nodes;       /* objects made inside intersections and
+                               differences so far (bounded by max_objects) */
     const char *const *include_dirs;
     size_t n_include_dirs;
     int no_include;         /* #include refused */
@@ -180,7 +182,7 @@ const char *rs__scene_add_file(rs_scene *scene, const char *name);
 /* ---- symbols.c ---- */
 void rs__val_free(val *v);
 int rs__val_copy(const val *src, val *dst);       /* -1: out of memory */
-int rs__group_push_object(rs_group *g, const rs_object *o); /* -1: no memory */
+int rs__group_push_object(rs_group *g, const rs_object *o); /* a deep copy; -1: no memory */
 int rs__group_push_light(rs_group *g, const rs_light *l);
 int rs__group_append(rs_group *dst, const rs_group *src);
 void rs__group_free(rs_group *g);

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "csg.h"
 #include "parse_internal.h"
 
 /* An rs_object is about 2.5 kB (a lens description holds two glasses), so
@@ -778,8 +779,12 @@ static int parse_term(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '*') || is_punct(peek(p), '/')) {
         rs_token op = take(p);
-        val b;
-        if (parse_unary(p, &b) != 0 || binary(p, &op, out, b) != 0)
+        val b = { 0 };   /* nothing to free until parsed */
+        if (parse_unary(p, &b) != 0) {
+            rs__val_free(&b);
+            return -1;
+        }
+        if (binary(p, &op, out, b) != 0)
             return -1;
     }
     return 0;
@@ -791,8 +796,12 @@ static int parse_sum(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '+') || is_punct(peek(p), '-')) {
         rs_token op = take(p);
-        val b;
-        if (parse_term(p, &b) != 0 || binary(p, &op, out, b) != 0)
+        val b = { 0 };   /* nothing to free until parsed */
+        if (parse_term(p, &b) != 0) {
+            rs__val_free(&b);
+            return -1;
+        }
+        if (binary(p, &op, out, b) != 0)
             return -1;
     }
     return 0;
@@ -820,7 +829,7 @@ static int parse_relation(parser *p, val *out)
         const rs_token *t = peek(p);
         rs_token op;
         char name[3] = { 0, 0, 0 };
-        val b;
+        val b = { 0 };   /* nothing to free until parsed */
         double x, y, r;
         if (!(is_punct(t, '=') || is_punct(t, '!') ||
               (!p->in_vector && out->kind == VAL_FLOAT &&
@@ -834,8 +843,10 @@ static int parse_relation(parser *p, val *out)
         } else if (op.punct == '!') {
             return expected(p, peek(p), "'=' after '!'");
         }
-        if (parse_sum(p, &b) != 0)
+        if (parse_sum(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         x = out->v[0];
         y = b.v[0];
         if (name[0] == '=')
@@ -857,9 +868,11 @@ static int parse_and(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '&')) {
         rs_token op = take(p);
-        val b;
-        if (parse_relation(p, &b) != 0)
+        val b = { 0 };   /* nothing to free until parsed */
+        if (parse_relation(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         if (compare(p, &op, "&", out, &b, out->v[0] != 0.0 && b.v[0] != 0.0) != 0)
             return -1;
     }
@@ -872,9 +885,11 @@ static int parse_or(parser *p, val *out)
         return -1;
     while (is_punct(peek(p), '|')) {
         rs_token op = take(p);
-        val b;
-        if (parse_and(p, &b) != 0)
+        val b = { 0 };   /* nothing to free until parsed */
+        if (parse_and(p, &b) != 0) {
+            rs__val_free(&b);
             return -1;
+        }
         if (compare(p, &op, "|", out, &b, out->v[0] != 0.0 || b.v[0] != 0.0) != 0)
             return -1;
     }
@@ -1480,7 +1495,14 @@ static int parse_texture(parser *p, rs_pigment *pig, rs_transform *pat, rs_finis
 /* ------------------------------------------------------------------ */
 
 static const char *const type_names[] = { "plane", "sphere", "box", "disc", "lens",
-                                          "polarizer", "cylinder", "cone", "torus" };
+                                          "polarizer", "cylinder", "cone", "torus", "csg" };
+static const char *const csg_names[] = { "union", "intersection", "difference" };
+static const char *const csg_phrases[] = { "a union", "an intersection", "a difference" };
+
+static const char *object_name(const rs_object *o)
+{
+    return o->type == RS_OBJ_CSG ? csg_names[o->u.csg.op] : type_names[o->type];
+}
 
 static void object_init(rs_object *o, rs_object_type type, const parser *p, const rs_token *kw)
 {
@@ -1504,7 +1526,9 @@ static int check_room(parser *p, size_t n, const rs_token *kw, const char *what)
     return 0;
 }
 
-static int push_object(parser *p, const rs_object *o, const rs_token *kw)
+/* Move o into the scene (o owns nothing afterwards); a CSG's members take
+ * their textures now that it is final. */
+static int push_object(parser *p, rs_object *o, const rs_token *kw)
 {
     rs_scene *s = p->scene;
     if (check_room(p, s->n_objects, kw, "objects") != 0)
@@ -1520,7 +1544,12 @@ static int push_object(parser *p, const rs_object *o, const rs_token *kw)
         s->objects = a;
         s->cap_objects = cap;
     }
-    s->objects[s->n_objects++] = *o;
+    s->objects[s->n_objects] = *o;
+    rs_csg_inherit(&s->objects[s->n_objects++]);
+    if (o->type == RS_OBJ_CSG) {
+        o->u.csg.members = NULL;
+        o->u.csg.n_members = 0;
+    }
     return 0;
 }
 
@@ -1558,7 +1587,7 @@ static int parse_interior(parser *p, double *ior)
  * transforms, then the object's written after it. */
 static int parse_object_modifiers(parser *p, rs_object *o)
 {
-    const char *name = type_names[o->type];
+    const char *name = object_name(o);
     rs_transform pat;
     char what[112];
 
@@ -1582,6 +1611,7 @@ static int parse_object_modifiers(parser *p, rs_object *o)
         } else if (is_id(t, "interior")) {
             if (parse_interior(p, &o->ior) != 0)
                 return -1;
+            o->has_interior = 1;
         } else if (is_id(t, "inverse")) {
             take(p);
             o->inverse = !o->inverse;
@@ -2199,6 +2229,12 @@ static int transform_object(parser *p, const rs_token *kw, rs_object *o, const r
         }
         return 0;
     }
+    if (o->type == RS_OBJ_CSG) {
+        for (size_t i = 0; i < o->u.csg.n_members; i++)
+            if (transform_object(p, kw, &o->u.csg.members[i], T) != 0)
+                return -1;
+        return 0;
+    }
     return apply_step(p, kw, &o->xf, T);
 }
 
@@ -2289,8 +2325,10 @@ static int parse_group_modifiers(parser *p, rs_group *g, int children, const cha
             double ior = 1.0;
             if (parse_interior(p, &ior) != 0)
                 return -1;
-            for (size_t i = 0; i < g->n_objects; i++)
+            for (size_t i = 0; i < g->n_objects; i++) {
                 g->objects[i].ior = ior;
+                g->objects[i].has_interior = 1;
+            }
         } else {
             snprintf(what, sizeof what, "%spigment, finish, texture, interior, translate, "
                                         "rotate, scale or '}' in %s",
@@ -2298,6 +2336,41 @@ static int parse_group_modifiers(parser *p, rs_group *g, int children, const cha
             return expected(p, t, what);
         }
     }
+}
+
+/* Every object of a CSG tree needs an inside: a lens, polarizer or disc
+ * anywhere in it is refused at its own place. */
+static int check_solid(parser *p, const rs_object *o, const char *csg)
+{
+    if (o->type == RS_OBJ_CSG) {
+        for (size_t i = 0; i < o->u.csg.n_members; i++)
+            if (check_solid(p, &o->u.csg.members[i], csg) != 0)
+                return -1;
+        return 0;
+    }
+    if (o->type == RS_OBJ_LENS)
+        return error_at(p, o->loc.line, o->loc.column,
+                        "a lens cannot be part of %s: write it on its own (it is one "
+                        "primitive with its own caps and rim)", csg);
+    if (o->type == RS_OBJ_POLARIZER || o->type == RS_OBJ_DISC)
+        return error_at(p, o->loc.line, o->loc.column,
+                        "a %s has no inside and cannot be part of %s: use a thin "
+                        "cylinder or box", type_names[o->type], csg);
+    return 0;
+}
+
+/* Count the objects a CSG tree adds to the scene's memory (its members
+ * are not in the scene's object count): at most max_objects in all. */
+static int count_nodes(parser *p, const rs_object *o, const rs_token *kw)
+{
+    if (o->type != RS_OBJ_CSG)
+        return 0;
+    p->csg_nodes += rs_object_node_count(o);
+    if (p->csg_nodes > p->max_objects)
+        return error_at(p, kw->line, kw->column,
+                        "too many objects in intersections and differences (the limit is "
+                        "%zu)", p->max_objects);
+    return 0;
 }
 
 /* object { NAME modifiers } */
@@ -2334,6 +2407,11 @@ static int parse_object_ref(parser *p, rs_group *g)
             rs__group_free(&mine);
             return error_at(p, t->line, t->column, "out of memory");
         }
+        for (size_t i = 0; i < mine.n_objects; i++)
+            if (count_nodes(p, &mine.objects[i], t) != 0) {
+                rs__group_free(&mine);
+                return -1;
+            }
         take(p);
     }
     rc = parse_group_modifiers(p, &mine, 0, "object");
@@ -2370,6 +2448,94 @@ static int parse_union(parser *p, rs_group *g)
     if (rc == 0 && rs__group_append(g, &mine) != 0)
         rc = error_at(p, kw.line, kw.column, "out of memory");
     rs__group_free(&mine);
+    return rc;
+}
+
+/* One member of a CSG from the objects one statement made: itself, or a
+ * union node over them (a union or merge statement, or object { NAME }
+ * of one).  The objects move into *out. */
+static void csg_member(parser *p, rs_group *one, rs_object *out, const rs_token *kw)
+{
+    if (one->n_objects == 1) {
+        *out = one->objects[0];
+        one->n_objects = 0;
+        return;
+    }
+    object_init(out, RS_OBJ_CSG, p, kw);
+    out->u.csg.op = RS_CSG_UNION;
+    out->u.csg.members = one->objects;
+    out->u.csg.n_members = one->n_objects;
+    one->objects = NULL;
+    one->n_objects = one->cap_objects = 0;
+}
+
+/* intersection / difference { objects modifiers }: one solid object.  Its
+ * transforms go down to the members; its pigment, finish, texture and
+ * interior stay with it until it is final (push_object), when every member
+ * without its own takes them (POV-Ray's rule). */
+static int parse_csg(parser *p, rs_group *g)
+{
+    rs_token kw = take(p);
+    rs_object o;
+    rs_group lights;
+    size_t cap = 0;
+    int rc = 0;
+
+    object_init(&o, RS_OBJ_CSG, p, &kw);
+    o.u.csg.op = is_id(&kw, "intersection") ? RS_CSG_INTERSECTION : RS_CSG_DIFFERENCE;
+    o.u.csg.members = NULL;
+    o.u.csg.n_members = 0;
+    if (open_block(p, csg_names[o.u.csg.op]) != 0)
+        return -1;
+    memset(&lights, 0, sizeof lights);
+    while (rc == 0 && is_object_start(p, peek(p))) {
+        rs_token mk = *peek(p);
+        rs_group one;
+        memset(&one, 0, sizeof one);
+        rc = parse_object_statement(p, &one);
+        for (size_t i = 0; rc == 0 && i < one.n_lights; i++)
+            if (rs__group_push_light(&lights, &one.lights[i]) != 0)
+                rc = error_at(p, mk.line, mk.column, "out of memory");
+        if (rc == 0 && one.n_objects > 0 && o.u.csg.n_members == cap) {
+            size_t ncap = cap ? 2 * cap : 4;
+            rs_object *grown = NULL;
+            if (ncap > p->max_objects)
+                ncap = p->max_objects;
+            if (cap >= ncap)
+                rc = error_at(p, mk.line, mk.column, "too many members (the limit is %zu)",
+                              p->max_objects);
+            else if ((grown = realloc(o.u.csg.members, ncap * sizeof *grown)) == NULL)
+                rc = error_at(p, mk.line, mk.column, "out of memory");
+            else {
+                o.u.csg.members = grown;
+                cap = ncap;
+            }
+        }
+        if (rc == 0 && one.n_objects > 0) {
+            csg_member(p, &one, &o.u.csg.members[o.u.csg.n_members], &mk);
+            rc = check_solid(p, &o.u.csg.members[o.u.csg.n_members++], csg_phrases[o.u.csg.op]);
+        }
+        rs__group_free(&one);
+    }
+    if (rc == 0 && o.u.csg.n_members == 0)
+        rc = error_at(p, kw.line, kw.column, "%s needs at least one object",
+                      csg_phrases[o.u.csg.op]);
+    if (rc == 0)
+        rc = parse_object_modifiers(p, &o);
+    /* the transforms written on the CSG move its members and lights */
+    for (size_t i = 0; rc == 0 && i < o.u.csg.n_members; i++)
+        rc = transform_object(p, &kw, &o.u.csg.members[i], &o.xf);
+    for (size_t i = 0; rc == 0 && i < lights.n_lights; i++)
+        rc = transform_light(p, &kw, &lights.lights[i], &o.xf);
+    rs_transform_identity(&o.xf);
+    if (rc == 0)
+        rc = count_nodes(p, &o, &kw);
+    if (rc == 0 && check_room(p, g->n_objects, &kw, "objects") != 0)
+        rc = -1;
+    if (rc == 0 && (rs__group_push_object(g, &o) != 0 || rs__group_append(g, &lights) != 0))
+        rc = error_at(p, kw.line, kw.column, "out of memory");
+    rs_object_release(&o);
+    rs__group_free(&lights);
     return rc;
 }
 
@@ -2652,9 +2818,7 @@ static int parse_object_statement(parser *p, rs_group *g)
     if (is_id(t, "light_source"))
         return parse_light(p, g);
     if (is_id(t, "intersection") || is_id(t, "difference"))
-        return error_at(p, t->line, t->column,
-                        "%.*s is not supported: use union, or a lens object for glass",
-                        (int)t->len, t->text);
+        return parse_csg(p, g);
     return expected(p, t, "an object");
 }
 
@@ -2858,7 +3022,8 @@ static int parse_scene(parser *p)
                                 (int)(t->len > 48 ? 48 : t->len), t->text);
             return expected(p, t, "camera, light_source, background, global_settings, an "
                                   "object (plane, sphere, box, disc, cylinder, cone, torus, "
-                                  "lens, polarizer, object, union, merge) or a directive");
+                                  "lens, polarizer, object, union, merge, intersection, difference) or a "
+                                  "directive");
         }
         if (rc < 0)
             return -1;

@@ -54,8 +54,13 @@
  *   cone { A, RA, B, RB [open] ... }  torus { MAJOR, MINOR ... }
  *   object { NAME | OBJECT  modifiers }  union / merge { objects modifiers }
  *     (kept as separate objects; a union's texture goes to the members
- *     without one; lenses and polarizers are refused inside; intersection
- *     and difference are refused)
+ *     without one; lenses and polarizers are refused inside)
+ *   intersection / difference { objects modifiers }: one RS_OBJ_CSG (csg.h)
+ *     of planes, spheres, boxes, cylinders, cones, tori and CSG (a union
+ *     inside is one member); the objects first, then the modifiers
+ *     (pigment, finish, texture, interior, inverse, transforms); a member
+ *     without a texture or interior takes its CSG's; lenses, polarizers
+ *     and discs are refused inside
  *     with pigment { NAME | COLOUR | checker [C1 [,] [C2]] + transforms },
  *     finish { NAME ambient C diffuse F brilliance F emission C phong F
  *              phong_size F specular F roughness F reflection F | C |

@@ -72,9 +72,65 @@ int rs_cone_hit(lp_vec3 base, double r1, lp_vec3 cap, double r2, int open, lp_ve
     return 1;
 }
 
-static double quartic(const double c[5], double t)
+/* c[0] + c[1] t + ... + c[deg] t^deg */
+static double poly(const double *c, int deg, double t)
 {
-    return (((c[4] * t + c[3]) * t + c[2]) * t + c[1]) * t + c[0];
+    double v = c[deg];
+    for (int i = deg - 1; i >= 0; i--)
+        v = v * t + c[i];
+    return v;
+}
+
+/* The root of the polynomial in (a, b) where its sign changes (fa, fb the
+ * values at the ends), by bisection to the last bit. */
+static double bisect(const double *c, int deg, double a, double b, double fa)
+{
+    for (int k = 0; k < 200; k++) {
+        double m = 0.5 * (a + b);
+        if (!(m > a && m < b))
+            break;
+        double fm = poly(c, deg, m);
+        if ((fa <= 0.0) == (fm <= 0.0)) {
+            a = m;
+            fa = fm;
+        } else {
+            b = m;
+        }
+    }
+    return 0.5 * (a + b);
+}
+
+/* The roots in (lo, hi] where the sign changes, ascending, into r (at most
+ * deg): between consecutive roots of the derivative the polynomial is
+ * monotonic, so each such piece holds at most one, found by bisection.  A
+ * ray that dips into a surface by any amount is caught this way (the dip's
+ * bottom is a root of the derivative), where sampling would step over it;
+ * a root of even order (an exact tangent) changes no sign and is not one. */
+static int sign_changes(const double *c, int deg, double lo, double hi, double *r)
+{
+    double d[4], cut[6];
+    int n = 0, nc = 0;
+    if (deg == 1) {
+        if (c[1] == 0.0)
+            return 0;
+        double t = -c[0] / c[1];
+        if (t > lo && t <= hi)
+            r[n++] = t;
+        return n;
+    }
+    for (int i = 1; i <= deg; i++)
+        d[i - 1] = i * c[i];
+    cut[nc++] = lo;
+    nc += sign_changes(d, deg - 1, lo, hi, cut + 1);
+    cut[nc++] = hi;
+    double fa = poly(c, deg, lo);
+    for (int i = 0; i + 1 < nc; i++) {
+        double a = cut[i], b = cut[i + 1], fb = poly(c, deg, b);
+        if (b > a && (fa <= 0.0) != (fb <= 0.0))
+            r[n++] = bisect(c, deg, a, b, fa);
+        fa = fb;
+    }
+    return n;
 }
 
 int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, double t1,
@@ -88,48 +144,32 @@ int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, do
         return 0;
     double sq = sqrt(disc);
     double lo = (-od - sq) / dd, hi = (-od + sq) / dd;
-    /* The samples span the sphere from t0 on, not cut at t1: the hit found
-     * does not depend on how near another object is. */
+    /* The roots are isolated over the sphere from t0 on, not cut at t1:
+     * the hit found does not depend on how near another object is. */
     if (lo < t0)
         lo = t0;
     if (!(lo < hi) || !(lo < t1))
         return 0;
-    double a2 = dd, a1 = 2.0 * od, a0 = oo + R2 - r2;
-    double b2 = d.x * d.x + d.z * d.z, b1 = 2.0 * (o.x * d.x + o.z * d.z),
-           b0 = o.x * o.x + o.z * o.z;
+    /* the quartic in s = t - lo, from the point where the ray enters the
+     * bounding sphere (no cancellation from a far origin) */
+    lp_vec3 q = madd(o, d, lo);
+    double qd = dot(q, d), qq = dot(q, q);
+    double a2 = dd, a1 = 2.0 * qd, a0 = qq + R2 - r2;
+    double b2 = d.x * d.x + d.z * d.z, b1 = 2.0 * (q.x * d.x + q.z * d.z),
+           b0 = q.x * q.x + q.z * q.z;
     double c[5] = {a0 * a0 - 4.0 * R2 * b0, 2.0 * a1 * a0 - 4.0 * R2 * b1,
                    a1 * a1 + 2.0 * a2 * a0 - 4.0 * R2 * b2, 2.0 * a2 * a1, a2 * a2};
-    double step = minor / 16.0 / sqrt(dd);
-    int steps = (int)fmin(4096.0, ceil((hi - lo) / step));
-    if (steps < 8)
-        steps = 8;
-    double prev_t = lo, prev_f = quartic(c, lo);
-    for (int i = 1; i <= steps; i++) {
-        double s = lo + (hi - lo) * i / steps, f = quartic(c, s);
-        if ((prev_f <= 0.0) != (f <= 0.0) && !(prev_t == lo && prev_f == 0.0)) {
-            double a = prev_t, b = s, fa = prev_f;
-            for (int k = 0; k < 80 && b - a > 1e-15 * (1.0 + fabs(b)); k++) {
-                double m = 0.5 * (a + b), fm = quartic(c, m);
-                if ((fa <= 0.0) == (fm <= 0.0)) {
-                    a = m;
-                    fa = fm;
-                } else {
-                    b = m;
-                }
-            }
-            double root = 0.5 * (a + b);
-            if (!(root > t0))
-                root = b;
-            if (!(root < t1))
-                return 0;
-            lp_vec3 p = madd(o, d, root);
-            double g = dot(p, p) + R2 - r2;
-            *t = root;
-            *n = (lp_vec3){g * p.x - 2.0 * R2 * p.x, g * p.y, g * p.z - 2.0 * R2 * p.z};
-            return 1;
-        }
-        prev_t = s;
-        prev_f = f;
+    double roots[4];
+    int nr = sign_changes(c, 4, 0.0, hi - lo, roots);
+    for (int i = 0; i < nr; i++) {
+        double root = lo + roots[i];
+        if (!(root > t0 && root < t1))
+            continue;
+        lp_vec3 p = madd(o, d, root);
+        double g = dot(p, p) + R2 - r2;
+        *t = root;
+        *n = (lp_vec3){g * p.x - 2.0 * R2 * p.x, g * p.y, g * p.z - 2.0 * R2 * p.z};
+        return 1;
     }
     return 0;
 }

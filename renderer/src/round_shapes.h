@@ -15,10 +15,11 @@ int rs_cone_hit(lp_vec3 base, double r1, lp_vec3 cap, double r2, int open, lp_ve
                 lp_vec3 d, double t0, double t1, double *t, lp_vec3 *n);
 
 /* The torus about the y axis through the origin: the circle of radius
- * major in the xz plane swept by a circle of radius minor.  The quartic is
- * sampled along the part of the ray inside the bounding sphere at steps of
- * at most minor/16 and each sign change refined by bisection, so a ray
- * that only grazes the tube (a chord shorter than a step) can be missed. */
+ * major in the xz plane swept by a circle of radius minor.  The roots of
+ * its quartic along the ray are isolated between the roots of its
+ * derivatives and refined by bisection, so a ray that only grazes the
+ * tube is found however short its chord; a ray exactly along a tangent
+ * (a double root) meets nothing there. */
 int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, double t1,
                  double *t, lp_vec3 *n);
 

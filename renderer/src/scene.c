@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "bvh.h"
+#include "csg.h"
 #include "scene.h"
 
 void rs_scene_init(rs_scene *scene)
@@ -51,8 +52,10 @@ void rs_scene_free(rs_scene *scene)
 {
     if (scene == NULL)
         return;
-    for (size_t i = 0; i < scene->n_objects; i++)
+    for (size_t i = 0; i < scene->n_objects; i++) {
         lp_lens_destroy(scene->objects[i].lens);
+        rs_object_release(&scene->objects[i]);
+    }
     free(scene->objects);
     free(scene->lights);
     for (size_t i = 0; i < scene->n_files; i++)

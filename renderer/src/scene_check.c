@@ -98,8 +98,44 @@ static const char *shape_problem(const rs_object *o)
                        o->u.torus.major > 0.0 && o->u.torus.minor > 0.0
                    ? NULL
                    : "torus: radii finite and > 0";
+    case RS_OBJ_CSG:
+        return o->u.csg.n_members > 0 && o->u.csg.members != NULL
+                   ? NULL
+                   : "a CSG object must have members";
     }
     return NULL;
+}
+
+/* One object and, for a CSG object, each of its members. */
+static int object_check(const rs_object *o, size_t index, char *msg, size_t msg_size)
+{
+    const char *what;
+    lp_error err;
+    if (o->loc.line < 1 || o->loc.column < 1)
+        return broken(msg, msg_size, NULL, "object %zu has no place in a file", index);
+    if (!rs_transform_finite(&o->xf) || !rs_transform_finite(&o->pigment.to_pattern))
+        return broken(msg, msg_size, &o->loc, "a transform is not finite");
+    if (!color_fin(o->pigment.color[0]) || !color_fin(o->pigment.color[1]))
+        return broken(msg, msg_size, &o->loc, "a pigment colour is not finite");
+    if (!finish_ok(&o->finish))
+        return broken(msg, msg_size, &o->loc,
+                      "finish: every value must be finite, phong_size and roughness > 0");
+    if (!isfinite(o->ior) || !(o->ior > 0.0))
+        return broken(msg, msg_size, &o->loc, "interior: ior must be finite and > 0");
+    if ((what = shape_problem(o)) != NULL)
+        return broken(msg, msg_size, &o->loc, "%s", what);
+    if (o->type == RS_OBJ_LENS && o->lens == NULL) {
+        /* not created yet: it must be a lens that can exist */
+        lp_lens *tmp = NULL;
+        if (lp_lens_create(&o->u.lens.desc, &tmp, &err) != LP_OK)
+            return broken(msg, msg_size, &o->loc, "lens: %s", err.message);
+        lp_lens_destroy(tmp);
+    }
+    if (o->type == RS_OBJ_CSG)
+        for (size_t i = 0; i < o->u.csg.n_members; i++)
+            if (object_check(&o->u.csg.members[i], i, msg, msg_size) != 0)
+                return -1;
+    return 0;
 }
 
 int rs_scene_check(const rs_scene *s, char *msg, size_t msg_size)
@@ -108,44 +144,23 @@ int rs_scene_check(const rs_scene *s, char *msg, size_t msg_size)
         msg[0] = '\0';
     if (s == NULL)
         return broken(msg, msg_size, NULL, "no scene");
-    for (size_t i = 0; i < s->n_objects; i++) {
-        const rs_object *o = &s->objects[i];
-        const char *what;
-        lp_error err;
-        if (o->loc.line < 1 || o->loc.column < 1)
-            return broken(msg, msg_size, NULL, "object %zu has no place in a file", i);
-        if (!rs_transform_finite(&o->xf) || !rs_transform_finite(&o->pigment.to_pattern))
-            return broken(msg, msg_size, &o->loc, "a transform is not finite");
-        if (!color_fin(o->pigment.color[0]) || !color_fin(o->pigment.color[1]))
-            return broken(msg, msg_size, &o->loc, "a pigment colour is not finite");
-        if (!finish_ok(&o->finish))
-            return broken(msg, msg_size, &o->loc,
-                          "finish: every value must be finite, phong_size and roughness > 0");
-        if (!isfinite(o->ior) || !(o->ior > 0.0))
-            return broken(msg, msg_size, &o->loc, "interior: ior must be finite and > 0");
-        if ((what = shape_problem(o)) != NULL)
-            return broken(msg, msg_size, &o->loc, "%s", what);
-        if (o->type == RS_OBJ_LENS && o->lens == NULL) {
-            /* not created yet: it must be a lens that can exist */
-            lp_lens *tmp = NULL;
-            if (lp_lens_create(&o->u.lens.desc, &tmp, &err) != LP_OK)
-                return broken(msg, msg_size, &o->loc, "lens: %s", err.message);
-            lp_lens_destroy(tmp);
-        }
-    }
+    for (size_t i = 0; i < s->n_objects; i++)
+        if (object_check(&s->objects[i], i, msg, msg_size) != 0)
+            return -1;
     for (size_t i = 0; i < s->n_lights; i++) {
         const rs_light *l = &s->lights[i];
-        if (!v3_finite(l->position) || !color_fin(l->color) || (l->polarized && !unit(l->polarization)) ||
-            !isfinite(l->coherence_length) || l->coherence_length < 0.0)
+        if (!v3_finite(l->position) || !color_fin(l->color) ||
+            (l->polarized && !unit(l->polarization)) || !isfinite(l->coherence_length) ||
+            l->coherence_length < 0.0)
             return broken(msg, msg_size, &l->loc,
                           "light_source: position and colour finite, polarization a unit "
                           "vector, coherence length finite and >= 0");
     }
     const rs_camera *c = &s->camera;
-    if (!v3_finite(c->location) || !v3_finite(c->direction) || !v3_finite(c->right) || !v3_finite(c->up) ||
-        !v3_finite(c->sky) || (c->has_look_at && !v3_finite(c->look_at)) ||
-        (c->has_angle && !isfinite(c->angle)) || !rs_transform_finite(&c->xf) || !v3_finite(c->focal_point) ||
-        !isfinite(c->aperture))
+    if (!v3_finite(c->location) || !v3_finite(c->direction) || !v3_finite(c->right) ||
+        !v3_finite(c->up) || !v3_finite(c->sky) || (c->has_look_at && !v3_finite(c->look_at)) ||
+        (c->has_angle && !isfinite(c->angle)) || !rs_transform_finite(&c->xf) ||
+        !v3_finite(c->focal_point) || !isfinite(c->aperture))
         return broken(msg, msg_size, NULL, "camera: a value is not finite");
     if (!color_fin(s->background) || !color_fin(s->settings.ambient_light))
         return broken(msg, msg_size, NULL, "background or ambient_light is not finite");

@@ -1,5 +1,6 @@
 /* shapes.c -- planes, spheres, boxes, discs, cylinders, cones, tori,
- * polarizers and lenses (round_shapes.c has the cylinder, cone and torus).
+ * polarizers and lenses (round_shapes.c has the cylinder, cone and torus,
+ * csg.c the intersections and differences).
  *
  * Plane, sphere, box and disc are intersected in object space: the world
  * ray is mapped by the inverse transform without renormalizing its
@@ -9,6 +10,7 @@
 #include <math.h>
 
 #include "bvh.h"
+#include "csg.h"
 #include "round_shapes.h"
 #include "shapes.h"
 
@@ -73,6 +75,9 @@ int rs_object_intersect(const rs_object *ob, lp_vec3 origin, lp_vec3 dir, double
     double t;
     lp_vec3 n_obj;
 
+    if (ob->type == RS_OBJ_CSG)
+        return rs_csg_intersect(ob, origin, dir, t_min, t_max, hit);
+    hit->surface = ob;
     if (ob->type == RS_OBJ_LENS) {
         lp_hit h;
         if (!ob->lens || !lp_lens_intersect(ob->lens, origin, dir, t_min, t_max, &h))

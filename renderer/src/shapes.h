@@ -10,6 +10,9 @@ typedef struct rs_hit {
     lp_vec3 point;   /* world */
     lp_vec3 normal;  /* world, unit, facing against the ray */
     int lens_surface;/* RS_OBJ_LENS: LP_SURFACE_* */
+    const rs_object *surface; /* the primitive whose surface was hit: the
+                                 object itself, or a CSG's member (its
+                                 pigment, finish and ior shade the hit) */
 } rs_hit;
 
 /* Nearest hit of origin + t dir (dir unit), t in (t_min, t_max), skipping
@@ -17,7 +20,8 @@ typedef struct rs_hit {
 int rs_scene_intersect(const rs_scene *scene, lp_vec3 origin, lp_vec3 dir, double t_min,
                        double t_max, int skip, rs_hit *hit);
 
-/* Intersect one object; fills t, point and normal (facing the ray). */
+/* Intersect one object; fills t, point, normal (facing the ray) and
+ * surface. */
 int rs_object_intersect(const rs_object *o, lp_vec3 origin, lp_vec3 dir, double t_min,
                         double t_max, rs_hit *hit);
 

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "csg.h"
 #include "parse_internal.h"
 
 static void group_init(rs_group *g)
@@ -17,6 +18,8 @@ static void group_init(rs_group *g)
 
 void rs__group_free(rs_group *g)
 {
+    for (size_t i = 0; i < g->n_objects; i++)
+        rs_object_release(&g->objects[i]);
     free(g->objects);
     free(g->lights);
     group_init(g);
@@ -32,7 +35,9 @@ int rs__group_push_object(rs_group *g, const rs_object *o)
         g->objects = a;
         g->cap_objects = cap;
     }
-    g->objects[g->n_objects++] = *o;
+    if (rs_object_copy(&g->objects[g->n_objects], o) != 0)
+        return -1;
+    g->n_objects++;
     return 0;
 }
 

@@ -224,8 +224,43 @@ static void test_shipped_microscope(void)
            rows[1].lt, ratio);
 }
 
+/* Bad input: a usage error exits 2, a scene that is no empty instrument
+ * exits 1, each with one line naming the problem. */
+static void test_refusals(void)
+{
+    static const struct {
+        const char *args[8];
+        int status;
+        const char *says;
+    } cases[] = {
+        {{"--lambda", "100", NULL}, 2, "--lambda"},
+        {{"--rings", "0", NULL}, 2, "--rings"},
+        {{"--azimuths", "4", NULL}, 2, "--azimuths"},
+        {{"--bogus", "1", NULL}, 2, "unknown option"},
+        {{"--step", NULL}, 2, "needs a value"},
+        {{"--scene", LP_SOURCE_DIR "/scenes/microscope/microscope.scene", NULL}, 1, "crystal"},
+        {{"--scene", LP_SOURCE_DIR "/scenes/conoscope.scene", NULL}, 1, "crystal"},
+        {{"--scene", LP_SOURCE_DIR "/scenes/default.scene", NULL}, 1, "0 polarizers"},
+        {{"--scene", LP_TEST_TMP "/no_such.scene", NULL}, 1, "no_such.scene"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        tp_result r;
+        if (tp_run(LP_BIN_DIR "/extinction_na", cases[k].args, NULL, &r) != 0) {
+            CHECK(0, "runs: %s", r.error);
+            continue;
+        }
+        CHECK(r.status == cases[k].status && strstr(r.err, cases[k].says) != NULL &&
+                  strchr(r.err, '\n') == r.err + strlen(r.err) - 1,
+              "%s %s: status %d (want %d), says '%s' (want '%s' on one line)", cases[k].args[0],
+              cases[k].args[1] ? cases[k].args[1] : "", r.status, cases[k].status, r.err,
+              cases[k].says);
+        tp_result_free(&r);
+    }
+}
+
 int main(void)
 {
+    test_refusals();
     test_against_closed_form();
     test_shipped_microscope();
     return check_finish("test_extinction");

@@ -152,6 +152,13 @@ static int scene_ok(const rs_scene *s, char *why, size_t n)
             ok = o->u.torus.major > 0.0 && o->u.torus.minor > 0.0 &&
                  isfinite(o->u.torus.major) && isfinite(o->u.torus.minor);
             break;
+        case RS_OBJ_CSG: /* members: solids only, never lenses, polarizers or discs */
+            ok = o->u.csg.n_members > 0 && o->u.csg.members != NULL;
+            for (size_t k = 0; ok && k < o->u.csg.n_members; k++) {
+                rs_object_type t = o->u.csg.members[k].type;
+                ok = t != RS_OBJ_LENS && t != RS_OBJ_POLARIZER && t != RS_OBJ_DISC;
+            }
+            break;
         }
         if (!ok) {
             snprintf(why, n, "object %zu (line %d) has a non-finite, zero or non-unit value", i,

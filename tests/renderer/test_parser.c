@@ -608,7 +608,7 @@ static void test_errors(void)
     expect_error("sphere { <0,0,0>, 1 }\nfoo", 2, 1,
                  "expected camera, light_source, background, global_settings, an object (plane, "
                  "sphere, box, disc, cylinder, cone, torus, lens, polarizer, object, union, "
-                 "merge) or a directive, found identifier 'foo'");
+                 "merge, intersection, difference) or a directive, found identifier 'foo'");
     expect_error("sphere <0,0,0>, 1 }", 1, 8, "expected '{' after 'sphere', found '<'");
     expect_error("camera { location <0,0,0>\n", 2, 1, "or '}' in camera, found end of file");
     expect_error("sphere { 0, 1 } }", 1, 17, "found '}'");
@@ -1182,8 +1182,6 @@ static void test_declared_values(void)
     expect_error("#declare F = finish { }; object { F }", 1, 35, "'F' is a finish, not an object");
     expect_error("union { lens { radius1 50 radius2 -50 thickness 5 diameter 20 ior 1.5 } }", 1, 9,
                  "a lens cannot be part of a union");
-    expect_error("intersection { sphere { 0, 1 } box { 0, 1 } }", 1, 1,
-                 "intersection is not supported");
     expect_error("cylinder { 0, 0, 1 }", 1, 15, "the cylinder's base and cap points must differ");
     expect_error("cylinder { 0, y, -1 }", 1, 18, "the cylinder radius must be positive");
     expect_error("cone { 0, -1, y, 1 }", 1, 11, "the cone's radii must be at least 0");
@@ -1246,6 +1244,107 @@ static void test_povray_includes(void)
     rs_scene_free(&s);
 }
 
+/* intersection and difference: the tree the parser builds (members in
+ * order, a union inside as one member, transforms moved down to the
+ * members, lights out to the scene, textures after POV-Ray's rule) and
+ * every error they can give. */
+static void test_csg(void)
+{
+    rs_scene s;
+    rs_parse_opts opts;
+    char msg[512];
+    int rc;
+
+    rc = parse("difference {\n"
+               "  box { -1, 1 }\n"
+               "  union { sphere { <0,1,0>, 0.5 } sphere { <0,-1,0>, 0.5 pigment { rgb <1,0,0> } } }\n"
+               "  cylinder { <0,0,-2>, <0,0,2>, 0.3 inverse }\n"
+               "  light_source { <0, 5, 0> rgb 1 }\n"
+               "  pigment { rgb <0,1,0> } interior { ior 1.4 } inverse\n"
+               "  translate <10, 0, 0>\n"
+               "}\n", &s, msg, sizeof msg);
+    CHECK(rc == 0, "difference parses: %s", msg);
+    if (rc == 0) {
+        const rs_object *o = &s.objects[0];
+        CHECK(s.n_objects == 1 && o->type == RS_OBJ_CSG && o->u.csg.op == RS_CSG_DIFFERENCE &&
+                  o->u.csg.n_members == 3 && o->inverse,
+              "one inverted difference of 3 members");
+        CHECK(o->loc.line == 1 && o->loc.column == 1, "the difference's location");
+        const rs_object *u = &o->u.csg.members[1];
+        CHECK(u->type == RS_OBJ_CSG && u->u.csg.op == RS_CSG_UNION && u->u.csg.n_members == 2,
+              "the union is one member, a union node of 2");
+        CHECK(o->u.csg.members[0].type == RS_OBJ_BOX && o->u.csg.members[2].inverse &&
+                  o->u.csg.members[2].type == RS_OBJ_CYLINDER,
+              "box first, the inverted cylinder last");
+        CHECK_ABS(o->u.csg.members[0].xf.t[0], 10, TOL, "the box moved with the difference");
+        CHECK_ABS(u->u.csg.members[1].xf.t[0], 10, TOL, "the union's sphere moved too");
+        CHECK(s.n_lights == 1, "the light inside goes to the scene");
+        if (s.n_lights == 1)
+            check_vec(s.lights[0].position, 10, 5, 0, TOL, "the light moved with it");
+        check_color(o->u.csg.members[0].pigment.color[0], 0, 1, 0, "untextured box: the CSG's");
+        check_color(u->u.csg.members[0].pigment.color[0], 0, 1, 0,
+                    "untextured sphere of the union: the CSG's");
+        check_color(u->u.csg.members[1].pigment.color[0], 1, 0, 0, "textured sphere: its own");
+        CHECK_ABS(o->u.csg.members[2].ior, 1.4, TOL, "the interior goes down too");
+    }
+    rs_scene_free(&s);
+
+    /* a declared CSG used twice: each copy its own, re-textured */
+    rc = parse("#declare D = intersection { box { -1, 1 } sphere { 0, 1.3 pigment { rgb <1,0,0> } } }\n"
+               "object { D translate x*5 pigment { rgb <0,0,1> } }\n"
+               "object { D translate -x*5 }\n", &s, msg, sizeof msg);
+    CHECK(rc == 0 && s.n_objects == 2, "declared CSG used twice: %s", msg);
+    if (rc == 0 && s.n_objects == 2) {
+        const rs_object *a = &s.objects[0], *b = &s.objects[1];
+        CHECK(a->u.csg.members != b->u.csg.members, "each copy owns its members");
+        CHECK_ABS(a->u.csg.members[0].xf.t[0], 5, TOL, "first copy at +5");
+        CHECK_ABS(b->u.csg.members[0].xf.t[0], -5, TOL, "second copy at -5");
+        check_color(a->u.csg.members[0].pigment.color[0], 0, 0, 1,
+                    "object { D pigment }: the untextured member takes it");
+        check_color(a->u.csg.members[1].pigment.color[0], 1, 0, 0,
+                    "... the textured member keeps its own");
+        check_color(b->u.csg.members[0].pigment.color[0], 0, 0, 0,
+                    "the other copy: POV-Ray's default pigment (black)");
+    }
+    rs_scene_free(&s);
+
+    /* nested, inside a union, in a #while */
+    rc = parse("#declare I = 0;\n#while (I < 3)\n"
+               "union { difference { sphere { 0, 1 } intersection { box { -1, 1 } plane { y, 0 } } }"
+               " translate x*I }\n#declare I = I + 1;\n#end\n", &s, msg, sizeof msg);
+    CHECK(rc == 0 && s.n_objects == 3 && s.objects[2].u.csg.n_members == 2 &&
+              s.objects[2].u.csg.members[1].type == RS_OBJ_CSG &&
+              s.objects[2].u.csg.members[1].u.csg.op == RS_CSG_INTERSECTION,
+          "nested CSG in a loop: %s", msg);
+    rs_scene_free(&s);
+
+    /* errors */
+    expect_error("intersection { lens { radius1 50 radius2 -50 thickness 5 diameter 20 ior 1.5 } }",
+                 1, 16, "a lens cannot be part of an intersection: write it on its own");
+    expect_error("difference { box { 0, 1 }\n  disc { 0, y, 1 } }", 2, 3,
+                 "a disc has no inside and cannot be part of a difference: use a thin cylinder "
+                 "or box");
+    expect_error("intersection { box { 0, 1 } polarizer { normal z radius 1 axis x } }", 1, 29,
+                 "a polarizer has no inside and cannot be part of an intersection");
+    expect_error("difference { box { 0, 1 } union { sphere { 0, 1 } disc { 0, y, 1 } } }", 1, 51,
+                 "a disc has no inside and cannot be part of a difference");
+    expect_error("intersection { }", 1, 1, "an intersection needs at least one object");
+    expect_error("difference { light_source { 0, 1 } }", 1, 1,
+                 "a difference needs at least one object");
+    expect_error("difference { box { 0, 1 } pigment { rgb 1 } sphere { 0, 1 } }", 1, 45,
+                 "expected pigment, finish, texture, interior, inverse, translate, rotate, scale "
+                 "or '}' in difference, found identifier 'sphere'");
+    expect_error("intersection { box { 0, 1 }", 1, 28, "or '}' in intersection, found end of file");
+    expect_error("difference sphere { 0, 1 }", 1, 12, "expected '{' after 'difference'");
+    rs_parse_opts_init(&opts);
+    opts.max_objects = 3;
+    expect_error_opts("intersection {\n sphere{0,1}\n sphere{0,1}\n sphere{0,1}\n sphere{0,1} }",
+                      &opts, 5, 2, "too many members (the limit is 3)");
+    expect_error_opts("#declare D = intersection { sphere{0,1} sphere{0,1} }\n"
+                      "object { D }\nobject {\n D }", &opts, 2, 10,
+                      "too many objects in intersections and differences (the limit is 3)");
+}
+
 int main(void)
 {
     test_transforms();
@@ -1264,5 +1363,6 @@ int main(void)
     test_declared_values();
     test_povray_includes();
     test_comments_and_misc();
+    test_csg();
     return check_finish("test_parser");
 }

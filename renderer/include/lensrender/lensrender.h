@@ -173,6 +173,12 @@ lr_status lr_scene_check(const rs_scene *description, lr_error *err);
 lr_status lr_camera_ray(const rs_camera *camera, int width, int height, double px, double py,
                         lp_vec3 *origin, lp_vec3 *dir, lr_error *err);
 
+/* Nonzero when the world point p is inside the object as the renderer
+ * sees it: the primitives with an inside (plane, sphere, box, cylinder,
+ * cone, torus) and CSG objects, `inverse` swapping inside and outside;
+ * discs, lenses and polarizers have no inside (0). */
+int lr_object_inside(const rs_object *object, lp_vec3 p);
+
 /* The RGB colour of a light for a renderer without spectra: its colour
  * for an RGB spectrum; for a line, the linear sRGB of the line exactly as
  * the spectral modes add it; for a black body, the linear sRGB of its

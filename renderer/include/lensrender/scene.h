@@ -94,8 +94,18 @@ typedef enum rs_object_type {
     RS_OBJ_POLARIZER,
     RS_OBJ_CYLINDER,
     RS_OBJ_CONE,
-    RS_OBJ_TORUS
+    RS_OBJ_TORUS,
+    RS_OBJ_CSG
 } rs_object_type;
+
+/* The set operations of a CSG object (csg.h): a union or merge inside an
+ * intersection or difference is one member of it, so it is kept as a
+ * node. */
+typedef enum rs_csg_op {
+    RS_CSG_UNION = 0,
+    RS_CSG_INTERSECTION,
+    RS_CSG_DIFFERENCE
+} rs_csg_op;
 
 typedef struct rs_object {
     rs_object_type type;
@@ -117,6 +127,9 @@ typedef struct rs_object {
         struct { lp_vec3 base, cap; double base_radius, cap_radius; int open; } cone;
         /* torus about the y axis, centred at the origin */
         struct { double major, minor; } torus;
+        /* intersection / difference (and a union inside them): the
+           members, owned, each with its transforms folded in (csg.h) */
+        struct { rs_csg_op op; struct rs_object *members; size_t n_members; } csg;
     } u;
     rs_transform xf;        /* object -> world (identity when none);
                                lenses and polarizers have it folded into
@@ -125,6 +138,8 @@ typedef struct rs_object {
     rs_finish finish;
     double ior;             /* interior { ior } (default 1): for fresnel
                                reflection of opaque objects */
+    int has_interior;       /* an interior was given (a CSG member without
+                               one takes its CSG's) */
     int has_texture;        /* a pigment, finish or texture was given (a
                                union passes its own to children without) */
     int inverse;            /* inside and outside swapped */
@@ -242,7 +257,8 @@ int rs_scene_prepare(rs_scene *scene, char *msg, size_t msg_size);
  * torus, polarizer radii > 0, cone radii >= 0, 0 <= a disc's hole <
  * its radius; phong_size, roughness and ior > 0; a light's coherence
  * length >= 0; every object placed in a file (line, column >= 1); a lens
- * not yet created one that lp_lens_create accepts.  The reader builds only
+ * not yet created one that lp_lens_create accepts; a CSG object has
+ * members, each keeping the same rules.  The reader builds only
  * scenes that obey them (it refuses each broken rule where it is written);
  * who builds or changes a scene otherwise calls this.  Returns 0, or -1
  * with "FILE:LINE:COL: what" (or "camera: ..." and the like) in msg. */
