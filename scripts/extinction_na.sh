@@ -8,7 +8,9 @@
 #
 #   sh scripts/extinction_na.sh [extinction_na options...]
 #
-# Environment: BUILD (build directory, default build).
+# Environment: BUILD (build directory, default build); MPIRUN="mpirun -n 4"
+# (any launcher command) shares the NA points among the processes of an
+# MPI run (the same outputs).
 set -eu
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
@@ -16,5 +18,6 @@ if [ ! -x "$BUILD/bin/extinction_na" ]; then
     cmake -S . -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
     cmake --build "$BUILD" -j2 --target extinction_na >/dev/null
 fi
-"$BUILD/bin/extinction_na" --scene scenes/microscope/microscope_empty.scene \
+# shellcheck disable=SC2086
+${MPIRUN:-} "$BUILD/bin/extinction_na" --scene scenes/microscope/microscope_empty.scene \
     --csv docs/extinction-na.csv --png docs/extinction-na.png "$@"

@@ -6,7 +6,10 @@
 set -eu
 cd "$(dirname "$0")/.."
 
-PACKAGES="gcc make cmake libc6-dev pkg-config libpng-dev zlib1g-dev povray povray-includes"
+# Open MPI (libopenmpi-dev, openmpi-bin) builds lensrender-mpi and runs the
+# sweeps across processes (LENSPRIM_MPI, README "Beyond one machine").
+PACKAGES="gcc make cmake libc6-dev pkg-config libpng-dev zlib1g-dev povray povray-includes
+          libopenmpi-dev openmpi-bin"
 
 missing=""
 for p in $PACKAGES; do

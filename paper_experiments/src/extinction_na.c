@@ -11,6 +11,8 @@
 #include <string.h>
 
 #include "extinction.h"
+#include "lpmpi/group.h"
+#include "lpmpi/schedule.h"
 #include "plot.h"
 #include "support/image.h"
 
@@ -36,6 +38,49 @@ static const char usage_text[] =
 "instrument's own aperture on the chart (default 0.45; 0: none).\n"
 "Writes --csv (default docs/extinction-na.csv) and --png (default\n"
 "docs/extinction-na.png) and prints the worst relative difference.\n";
+
+/* The NA points as independent items (lpmpi/schedule.h): one process, or
+ * shared among the processes of an MPI run (mpirun -n N extinction_na),
+ * gathered on rank 0. */
+typedef struct na_sweep {
+    const ext_system *sys;
+    double step, h_max;
+    int rings, azimuths;
+    ext_point *pt;       /* rank 0: point k */
+    int *ok;             /* rank 0: point k was computed */
+    char (*why)[256];    /* rank 0: why not */
+} na_sweep;
+
+typedef struct na_result {
+    ext_point pt;
+    int ok;
+    char why[256];
+} na_result;
+
+static int na_run(void *user, long k, void *result, size_t *used, char *msg, size_t msg_size)
+{
+    const na_sweep *w = user;
+    na_result r;
+    (void)msg;
+    (void)msg_size;
+    memset(&r, 0, sizeof r);
+    r.ok = ext_point_compute(w->sys, w->step * (double)(k + 1), w->h_max, w->rings,
+                             w->azimuths, &r.pt, r.why, sizeof r.why) == 0;
+    memcpy(result, &r, sizeof r);
+    *used = sizeof r;
+    return 0;
+}
+
+static void na_done(void *user, long k, const void *result, size_t size)
+{
+    na_sweep *w = user;
+    na_result r;
+    (void)size;
+    memcpy(&r, result, sizeof r);
+    w->pt[k] = r.pt;
+    w->ok[k] = r.ok;
+    memcpy(w->why[k], r.why, sizeof r.why);
+}
 
 static int number(const char *opt, const char *v, double lo, double hi, double *out)
 {
@@ -161,19 +206,38 @@ int main(int argc, char **argv)
 
     char msg[512] = "";
     ext_system sys;
-    if (ext_system_from_scene(scene, lambda, &sys, msg, sizeof msg) != 0) {
+    mw_group *g;
+    if (mw_group_start(&argc, &argv, &g, msg, sizeof msg) != 0) {
         fprintf(stderr, "extinction_na: %s\n", msg);
         return 1;
     }
-    static ext_point pt[MAX_POINTS];
-    int m = 0, rc = 0;
-    for (int i = 0; i < n; i++) {
-        if (ext_point_compute(&sys, step * (i + 1), h_max, rings, azimuths, &pt[m], msg,
-                              sizeof msg) != 0)
-            break; /* the lenses pass no steeper ray */
-        m++;
+    int st = ext_system_from_scene(scene, lambda, &sys, msg, sizeof msg) != 0;
+    if (mw_agree(g, st, NULL, msg, sizeof msg) != 0) {
+        if (mw_group_rank(g) == 0)
+            fprintf(stderr, "extinction_na: %s\n", msg);
+        if (!st)
+            ext_system_free(&sys);
+        mw_group_end(g);
+        return 1;
     }
+    static ext_point pt[MAX_POINTS];
+    static int ok[MAX_POINTS];
+    static char why[MAX_POINTS][256];
+    na_sweep w = {&sys, step, h_max, rings, azimuths, pt, ok, why};
+    mw_job job = {n, sizeof(na_result), na_run, na_done, &w};
+    int m = 0, rc = mw_run(g, &job, msg, sizeof msg);
     ext_system_free(&sys);
+    if (mw_group_rank(g) != 0 || rc != 0) {
+        if (rc != 0 && mw_group_rank(g) == 0)
+            fprintf(stderr, "extinction_na: %s\n", msg);
+        mw_group_end(g);
+        return rc != 0;
+    }
+    mw_group_end(g);
+    while (m < n && ok[m]) /* up to the first NA the lenses pass no ray at */
+        m++;
+    if (m < n)
+        snprintf(msg, sizeof msg, "%s", why[m]);
     if (m < 2) {
         fprintf(stderr, "extinction_na: fewer than two points (%s)\n", msg);
         return 1;

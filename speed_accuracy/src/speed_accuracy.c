@@ -20,6 +20,8 @@
 #include <dirent.h>
 #include <unistd.h>
 
+#include "lpmpi/group.h"
+#include "lpmpi/schedule.h"
 #include "support/image.h"
 #include "sa_chart.h"
 #include "sa_error.h"
@@ -57,12 +59,18 @@ static const char *const usage_text[] = {
 "to the cap, and depth 64).  ERROR: RMSE of linear RGB against it, the\n"
 "largest channel difference, and the share of pixels with a channel off\n"
 "by more than 1/255 after the sRGB curve.  TIME: CPU seconds of the\n"
-"lensrender (or povray) process, --threads 1.\n",
+"lensrender (or povray) process, --threads 1.\n"
+"\n"
+"ACROSS PROCESSES: mpirun -n N speed_accuracy ... (a build with MPI) shares\n"
+"the references, then the points, among N processes (each needs the\n"
+"scenes and --bin at the same paths, and a --work directory of its own or\n"
+"a shared one); rank 0 writes the same table but for the times.\n",
 };
 
 typedef struct opts {
     const char *bin, *scenes, *docs, *work;
     int width, height, runs, max_wavelengths, reuse, chart_only, references_only;
+    int rank; /* this process's, in a run across processes (names its renders) */
     const char *only[64];
     int n_only;
 } opts;
@@ -91,7 +99,7 @@ static int cmp_double(const void *a, const void *b)
 
 typedef struct scene_ctx {
     const opts *o;
-    const char *path;    /* the scene file */
+    char path[PATH_MAX_LEN]; /* the scene file */
     char name[256];      /* its base name without .scene */
     char dir[PATH_MAX_LEN]; /* its work directory */
     rs_image ref;
@@ -111,8 +119,8 @@ static int render(const scene_ctx *sc, sa_point *p, int runs, rs_image *img)
     double times[16];
 
     snprintf(exe, sizeof exe, "%s/lensrender", sc->o->bin);
-    snprintf(pfm, sizeof pfm, "%s/render.pfm", sc->dir);
-    snprintf(png, sizeof png, "%s/render.png", sc->dir);
+    snprintf(pfm, sizeof pfm, "%s/render-%d.pfm", sc->dir, sc->o->rank);
+    snprintf(png, sizeof png, "%s/render-%d.png", sc->dir, sc->o->rank);
     snprintf(w, sizeof w, "%d", sc->o->width);
     snprintf(h, sizeof h, "%d", sc->o->height);
     argv[n++] = exe;
@@ -292,7 +300,7 @@ static int make_reference(scene_ctx *sc)
     sc->ref = base;
     sc->ref_wavelengths = n;
     sc->ref_depth = d;
-    return save_reference(sc);
+    return 0; /* saved by the process that gathers (reference_done) */
 }
 
 /* ---- POV-Ray's own point ------------------------------------------------ */
@@ -300,12 +308,11 @@ static int make_reference(scene_ctx *sc)
 /* pov_compare writes the POV-Ray scene (glass a constant index n_d, no
  * dispersion, adc_bailout 0, the scene's depth); then povray renders it
  * on one thread, timed like every other point. */
-static int povray_point(const scene_ctx *sc, sa_point *p)
+static int povray_point(const scene_ctx *sc, sa_point *p, rs_image *img)
 {
     char exe[PATH_BUF], out[PATH_BUF], w[16], h[16], msg[512];
     char a_w[24], a_h[24];
     sa_run_result res;
-    rs_image img;
     int bits;
     double times[16];
     int runs = sc->o->runs > 16 ? 16 : sc->o->runs;
@@ -338,12 +345,10 @@ static int povray_point(const scene_ctx *sc, sa_point *p)
     p->seconds = runs % 2 ? times[runs / 2] : 0.5 * (times[runs / 2 - 1] + times[runs / 2]);
     p->runs = runs;
     snprintf(out, sizeof out, "%s/pov/point.png", sc->dir);
-    if (rs_png_read(out, &img, &bits, msg, sizeof msg) != 0) {
+    if (rs_png_read(out, img, &bits, msg, sizeof msg) != 0) {
         say("%s: %s", out, msg);
         return -1;
     }
-    sa_error_measure(&img, &sc->ref, &p->err);
-    rs_image_free(&img);
     snprintf(p->note, sizeof p->note, "POV-Ray 3.7, glass at n_d, no dispersion");
     return 0;
 }
@@ -373,47 +378,69 @@ static int in_sweep(int m, int wl, int d, int c)
     return full || (DEPTHS[d] == 16 && c == 0) || (DEPTHS[d] == 8 && CUTOFFS[c] == 1e-3);
 }
 
-/* Render p, measure it against the reference and record it. */
-static int measure(const scene_ctx *sc, sa_point *p, sa_points *all, FILE *csv)
+/* ---- the runs, spread over the processes of the run -------------------
+ *
+ * Two rounds of independent items (lpmpi/schedule.h: one process alone,
+ * or every process of an MPI run): first each scene's reference, then
+ * every point of every scene.  An item's result is its numbers and its
+ * image; the process that gathers (rank 0) measures each point against
+ * its scene's reference and writes the table in the order of the points,
+ * so the table is the same however many processes ran it (but for the
+ * times). */
+
+typedef struct job_point {
+    int scene;     /* index into the scenes */
+    sa_point p;    /* the setting; rank 0: measured */
+    int measured;  /* rank 0: arrived (a POV-Ray point that could not run
+                      does not) */
+} job_point;
+
+typedef struct sweep {
+    const opts *o;
+    scene_ctx *sc;
+    int n_sc;
+    job_point *pts;
+    long n_pts, cap;
+} sweep;
+
+/* What an item's result starts with; the image's floats follow. */
+typedef struct item_head {
+    int width, height; /* 0 x 0: no image (a point that could not run) */
+    sa_point p;        /* a point's numbers */
+    int ref_wavelengths, ref_depth; /* a reference's */
+    double ref_dn_max, ref_dd_max, ref_dn_rmse;
+} item_head;
+
+static int add_point(sweep *w, int scene, const sa_point *p)
 {
-    rs_image img;
-    memset(&img, 0, sizeof img);
-    if (render(sc, p, sc->o->runs, &img) != 0)
-        return -1;
-    sa_error_measure(&img, &sc->ref, &p->err);
-    rs_image_free(&img);
-    snprintf(p->scene, sizeof p->scene, "%.63s", sc->name);
-    return sa_points_add(all, p) != 0 || sa_point_write_csv(csv, p) != 0 ? -1 : 0;
+    if (w->n_pts == w->cap) {
+        long cap = w->cap ? 2 * w->cap : 256;
+        job_point *q = realloc(w->pts, (size_t)cap * sizeof *q);
+        if (!q)
+            return -1;
+        w->pts = q;
+        w->cap = cap;
+    }
+    memset(&w->pts[w->n_pts], 0, sizeof *w->pts);
+    w->pts[w->n_pts].scene = scene;
+    w->pts[w->n_pts].p = *p;
+    snprintf(w->pts[w->n_pts].p.scene, sizeof p->scene, "%.63s", w->sc[scene].name);
+    w->n_pts++;
+    return 0;
 }
 
-static int run_scene(scene_ctx *sc, sa_points *all, FILE *csv)
+/* Every point of scene k, in the table's order (after its reference). */
+static int list_points(sweep *w, int k)
 {
     sa_point p;
-
-    if (make_reference(sc) != 0)
+    sa_point_init(&p, "povray", "povray", 0, 0, 0.0);
+    if (add_point(w, k, &p) != 0)
         return -1;
-    if (sc->o->references_only)
-        return 0;
-    sa_point_init(&p, "reference", "polarized", sc->ref_wavelengths, sc->ref_depth, 0.0);
-    snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
-    snprintf(p.note, sizeof p.note, "doubling wavelengths: max %.3g rmse %.3g; depth: max %.3g",
-             sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max);
-    p.seconds = NAN;
-    if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
-        return -1;
-
-    if (povray_point(sc, &p) == 0) {
-        snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
-        if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
-            return -1;
-    }
     for (size_t t = 0; t < N_OF(TOLERANCES); t++) {
         sa_point_init(&p, "auto", "auto", 0, 0, -1.0);
         p.tolerance = TOLERANCES[t];
-        if (measure(sc, &p, all, csv) != 0)
+        if (add_point(w, k, &p) != 0)
             return -1;
-        fprintf(stderr, "speed_accuracy: %s: auto %g: %.3g s, rmse %.3g (%s)\n", sc->name,
-                p.tolerance, p.seconds, p.err.rmse, p.note);
     }
     for (size_t m = 0; m < N_OF(MODELS); m++)
         for (size_t wl = 0; wl < N_OF(WAVELENGTHS); wl++)
@@ -423,12 +450,195 @@ static int run_scene(scene_ctx *sc, sa_points *all, FILE *csv)
                         continue;
                     sa_point_init(&p, "sweep", MODELS[m], m == 3 ? 0 : WAVELENGTHS[wl],
                                   DEPTHS[d], CUTOFFS[c]);
-                    if (measure(sc, &p, all, csv) != 0)
+                    if (add_point(w, k, &p) != 0)
                         return -1;
                 }
     /* The default polarized render, for the ratio the page reports. */
     sa_point_init(&p, "default", "polarized", 0, 0, -1.0);
-    return measure(sc, &p, all, csv);
+    return add_point(w, k, &p);
+}
+
+static size_t item_bytes(const opts *o)
+{
+    return sizeof(item_head) + 3 * sizeof(float) * (size_t)o->width * (size_t)o->height;
+}
+
+/* The head and the image into an item's result. */
+static void pack(item_head *h, const rs_image *img, void *result, size_t *used,
+                 const opts *o)
+{
+    size_t n = 0;
+    if (img && img->rgb && img->width == o->width && img->height == o->height) {
+        h->width = img->width;
+        h->height = img->height;
+        n = 3 * sizeof(float) * (size_t)img->width * (size_t)img->height;
+        memcpy((char *)result + sizeof *h, img->rgb, n);
+    }
+    memcpy(result, h, sizeof *h);
+    *used = sizeof *h + n;
+}
+
+/* The image of a result (not copied: it points into the result). */
+static rs_image unpack(const void *result, item_head *h)
+{
+    rs_image img = {0, 0, NULL};
+    memcpy(h, result, sizeof *h);
+    if (h->width > 0) {
+        img.width = h->width;
+        img.height = h->height;
+        img.rgb = (float *)((char *)result + sizeof *h);
+    }
+    return img;
+}
+
+static int reference_run(void *user, long k, void *result, size_t *used, char *msg,
+                         size_t msg_size)
+{
+    sweep *w = user;
+    scene_ctx *sc = &w->sc[k];
+    item_head h;
+    (void)msg_size;
+    msg[0] = '\0'; /* make_reference says what failed */
+    fprintf(stderr, "speed_accuracy: %s\n", sc->name);
+    if (make_reference(sc) != 0)
+        return 1;
+    memset(&h, 0, sizeof h);
+    h.ref_wavelengths = sc->ref_wavelengths;
+    h.ref_depth = sc->ref_depth;
+    h.ref_dn_max = sc->ref_dn_max;
+    h.ref_dd_max = sc->ref_dd_max;
+    h.ref_dn_rmse = sc->ref_dn_rmse;
+    pack(&h, &sc->ref, result, used, w->o);
+    rs_image_free(&sc->ref); /* rank 0 gets it back in reference_done */
+    return 0;
+}
+
+static void reference_done(void *user, long k, const void *result, size_t size)
+{
+    sweep *w = user;
+    scene_ctx *sc = &w->sc[k];
+    item_head h;
+    rs_image img = unpack(result, &h);
+    (void)size;
+    sc->ref_wavelengths = h.ref_wavelengths;
+    sc->ref_depth = h.ref_depth;
+    sc->ref_dn_max = h.ref_dn_max;
+    sc->ref_dd_max = h.ref_dd_max;
+    sc->ref_dn_rmse = h.ref_dn_rmse;
+    rs_image_free(&sc->ref);
+    if (!img.rgb || rs_image_create(&sc->ref, img.width, img.height) != 0) {
+        say("%s: the reference is lost (out of memory)%s", sc->name, "");
+        return;
+    }
+    memcpy(sc->ref.rgb, img.rgb, 3 * sizeof(float) * (size_t)img.width * (size_t)img.height);
+    if (save_reference(sc) != 0)
+        say("%s: the reference could not be saved%s", sc->name, "");
+}
+
+static int point_run(void *user, long k, void *result, size_t *used, char *msg,
+                     size_t msg_size)
+{
+    sweep *w = user;
+    job_point *jp = &w->pts[k];
+    item_head h;
+    rs_image img = {0, 0, NULL};
+    int rc;
+    (void)msg_size;
+    msg[0] = '\0'; /* render says what failed */
+    memset(&h, 0, sizeof h);
+    h.p = jp->p;
+    if (strcmp(h.p.kind, "povray") == 0) {
+        /* Without POV-Ray the point is left out (no image), as before. */
+        povray_point(&w->sc[jp->scene], &h.p, &img);
+        snprintf(h.p.scene, sizeof h.p.scene, "%s", jp->p.scene);
+        rc = 0;
+    } else {
+        rc = render(&w->sc[jp->scene], &h.p, w->o->runs, &img);
+    }
+    if (rc == 0)
+        pack(&h, &img, result, used, w->o);
+    rs_image_free(&img);
+    return rc == 0 ? 0 : 1;
+}
+
+static void point_done(void *user, long k, const void *result, size_t size)
+{
+    sweep *w = user;
+    job_point *jp = &w->pts[k];
+    item_head h;
+    rs_image img = unpack(result, &h);
+    (void)size;
+    if (!img.rgb)
+        return;
+    jp->p = h.p;
+    sa_error_measure(&img, &w->sc[jp->scene].ref, &jp->p.err);
+    jp->measured = 1;
+    if (strcmp(jp->p.kind, "auto") == 0)
+        fprintf(stderr, "speed_accuracy: %s: auto %g: %.3g s, rmse %.3g (%s)\n", jp->p.scene,
+                jp->p.tolerance, jp->p.seconds, jp->p.err.rmse, jp->p.note);
+}
+
+/* Rank 0: the table, each scene's reference first, then its points. */
+static int write_table(const sweep *w, FILE *csv, sa_points *all)
+{
+    long k = 0;
+    for (int s = 0; s < w->n_sc; s++) {
+        const scene_ctx *sc = &w->sc[s];
+        sa_point p;
+        sa_point_init(&p, "reference", "polarized", sc->ref_wavelengths, sc->ref_depth, 0.0);
+        snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
+        snprintf(p.note, sizeof p.note, "doubling wavelengths: max %.3g rmse %.3g; depth: max %.3g",
+                 sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max);
+        p.seconds = NAN;
+        if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
+            return -1;
+        for (; k < w->n_pts && w->pts[k].scene == s; k++)
+            if (w->pts[k].measured &&
+                (sa_points_add(all, &w->pts[k].p) != 0 ||
+                 sa_point_write_csv(csv, &w->pts[k].p) != 0))
+                return -1;
+    }
+    return 0;
+}
+
+/* Both rounds; rank 0 writes the table into csv.  Returns 0, or 1 after
+ * the message (on whichever process saw the failure; rank 0 prints a
+ * message of the run's own). */
+static int run_sweep(mw_group *g, sweep *w, FILE *csv, sa_points *all)
+{
+    char msg[1024] = "";
+    mw_job job;
+    int rc;
+    memset(&job, 0, sizeof job);
+    job.n_items = w->n_sc;
+    job.result_size = item_bytes(w->o);
+    job.run = reference_run;
+    job.done = reference_done;
+    job.user = w;
+    rc = mw_run(g, &job, msg, sizeof msg);
+    if (rc == 0 && !w->o->references_only) {
+        for (int s = 0; s < w->n_sc; s++)
+            if (list_points(w, s) != 0) {
+                snprintf(msg, sizeof msg, "out of memory");
+                rc = -1;
+            }
+        rc = mw_agree(g, rc, NULL, msg, sizeof msg);
+        job.n_items = w->n_pts;
+        job.run = point_run;
+        job.done = point_done;
+        if (rc == 0)
+            rc = mw_run(g, &job, msg, sizeof msg);
+    }
+    if (rc != 0) {
+        if (msg[0] && w->o->rank == 0)
+            say("%s%s", msg, "");
+        return 1;
+    }
+    if (w->o->rank == 0 && !w->o->references_only && write_table(w, csv, all) != 0) {
+        say("cannot write the table%s%s", "", "");
+        return 1;
+    }
+    return 0;
 }
 
 /* ---- options ---------------------------------------------------------- */
@@ -520,77 +730,97 @@ int main(int argc, char **argv)
     opts o;
     sa_points all;
     char csv_path[PATH_BUF], msg[512];
+    mw_group *g;
+    int rc = 0;
     memset(&o, 0, sizeof o);
     if (parse(&o, argc, argv) != 0)
         return EXIT_USAGE;
-    sa_points_init(&all);
-    snprintf(csv_path, sizeof csv_path, "%.4000s/speed-accuracy.csv", o.docs);
-    if (make_dir(o.docs) != 0) {
-        say("%s: cannot create: %s", o.docs, strerror(errno));
+    if (mw_group_start(&argc, &argv, &g, msg, sizeof msg) != 0) {
+        say("%s%s", msg, "");
         return 1;
     }
+    o.rank = mw_group_rank(g);
+    sa_points_init(&all);
+    snprintf(csv_path, sizeof csv_path, "%.4000s/speed-accuracy.csv", o.docs);
+    if (o.rank == 0 && make_dir(o.docs) != 0) {
+        say("%s: cannot create: %s", o.docs, strerror(errno));
+        rc = 1;
+    }
 
-    if (o.chart_only) {
-        if (sa_points_read_csv(csv_path, &all, msg, sizeof msg) != 0) {
+    if (rc == 0 && o.chart_only) {
+        if (o.rank == 0 && sa_points_read_csv(csv_path, &all, msg, sizeof msg) != 0) {
             say("%s: %s", csv_path, msg);
-            return 1;
+            rc = 1;
         }
-    } else {
+    } else if (rc == 0) {
         char *names[256];
         int n_names = 0;
-        FILE *csv;
+        FILE *csv = NULL;
         char tmp[PATH_BUF + 8];
+        sweep w;
         DIR *dir = opendir(o.scenes);
         struct dirent *de;
+        memset(&w, 0, sizeof w);
+        w.o = &o;
         if (!dir) {
             say("%s: cannot list: %s", o.scenes, strerror(errno));
-            return 1;
+            rc = 1;
         }
-        while ((de = readdir(dir)) != NULL && n_names < 256) {
+        while (dir && (de = readdir(dir)) != NULL && n_names < 256) {
             size_t n = strlen(de->d_name);
             if (n > 6 && strcmp(de->d_name + n - 6, ".scene") == 0)
                 names[n_names++] = strdup(de->d_name);
         }
-        closedir(dir);
+        if (dir)
+            closedir(dir);
         qsort(names, (size_t)n_names, sizeof *names, cmp_str);
-        snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
-        csv = fopen(tmp, "w");
-        if (!csv || sa_point_write_csv_header(csv) != 0) {
-            say("%s: cannot write%s", tmp, "");
-            return 1;
-        }
-        for (int k = 0; k < n_names; k++) {
-            scene_ctx sc;
-            char path[PATH_MAX_LEN];
-            memset(&sc, 0, sizeof sc);
-            sc.o = &o;
-            snprintf(sc.name, sizeof sc.name, "%.*s", (int)(strlen(names[k]) - 6), names[k]);
-            if (!wanted(&o, sc.name))
+        w.sc = calloc((size_t)n_names + 1, sizeof *w.sc);
+        for (int k = 0; rc == 0 && w.sc && k < n_names; k++) {
+            scene_ctx *sc = &w.sc[w.n_sc];
+            sc->o = &o;
+            snprintf(sc->name, sizeof sc->name, "%.*s", (int)(strlen(names[k]) - 6), names[k]);
+            if (!wanted(&o, sc->name))
                 continue;
-            snprintf(path, sizeof path, "%s/%s", o.scenes, names[k]);
-            sc.path = path;
-            snprintf(sc.dir, sizeof sc.dir, "%.3800s/%.255s", o.work, sc.name);
-            if (make_dir(sc.dir) != 0) {
-                say("%s: cannot create%s", sc.dir, "");
-                return 1;
+            snprintf(sc->path, sizeof sc->path, "%.3800s/%.255s", o.scenes, names[k]);
+            snprintf(sc->dir, sizeof sc->dir, "%.3800s/%.255s", o.work, sc->name);
+            if (make_dir(sc->dir) != 0) {
+                say("%s: cannot create%s", sc->dir, "");
+                rc = 1;
             }
-            fprintf(stderr, "speed_accuracy: %s\n", sc.name);
-            if (run_scene(&sc, &all, csv) != 0)
-                return 1;
-            fflush(csv);
-            rs_image_free(&sc.ref);
+            w.n_sc++;
+        }
+        if (o.rank == 0 && rc == 0) {
+            snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
+            csv = fopen(tmp, "w");
+            if (!csv || sa_point_write_csv_header(csv) != 0) {
+                say("%s: cannot write%s", tmp, "");
+                rc = 1;
+            }
+        }
+        /* Every process must see the scenes and its directories. */
+        if (mw_agree(g, rc, NULL, msg, sizeof msg) != 0)
+            rc = 1;
+        if (rc == 0)
+            rc = run_sweep(g, &w, csv, &all);
+        if (csv && (fclose(csv) != 0 || (rc == 0 && !o.references_only &&
+                                          rename(tmp, csv_path) != 0))) {
+            say("%s: cannot write%s", csv_path, "");
+            rc = 1;
         }
         for (int k = 0; k < n_names; k++)
             free(names[k]);
-        if (fclose(csv) != 0 || rename(tmp, csv_path) != 0) {
-            say("%s: cannot write%s", csv_path, "");
-            return 1;
-        }
+        for (int k = 0; w.sc && k < w.n_sc; k++)
+            rs_image_free(&w.sc[k].ref);
+        free(w.sc);
+        free(w.pts);
     }
-    if (sa_chart_write(&all, o.docs, msg, sizeof msg) != 0) {
+    if (rc == 0 && o.rank == 0 && !o.references_only &&
+        sa_chart_write(&all, o.docs, msg, sizeof msg) != 0) {
         say("chart: %s%s", msg, "");
-        return 1;
+        rc = 1;
     }
     sa_points_free(&all);
-    return 0;
+    rc = mw_agree(g, rc, NULL, msg, sizeof msg) != 0 ? 1 : 0;
+    mw_group_end(g);
+    return rc;
 }
