@@ -806,17 +806,11 @@ int main(int argc, char **argv)
         free(a);
         return EXIT_BAD;
     }
-    if (a->help) {
-        for (size_t i = 0; i < sizeof usage_text / sizeof *usage_text; i++)
-            fputs(usage_text[i], stdout);
+    if (a->help || a->version) {
+        int rc = a->help ? sp_print_text(usage_text, sizeof usage_text / sizeof *usage_text)
+                         : sp_print_version("lenstrace", lp_version_string());
         free(a);
-        return fflush(stdout) == 0 ? 0 : EXIT_BAD;
-    }
-    if (a->version) {
-        printf("lenstrace (lensprim) %d.%d.%d\n", LP_VERSION_MAJOR,
-               LP_VERSION_MINOR, LP_VERSION_PATCH);
-        free(a);
-        return fflush(stdout) == 0 ? 0 : EXIT_BAD;
+        return rc == 0 ? 0 : EXIT_BAD;
     }
 
     memset(&r, 0, sizeof r);

@@ -11,22 +11,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "support/cli.h"
+
 #define LT_TOKEN_MAX 256 /* longest key=value item */
 
-static const char *fail(lt_args *args, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
-
-static const char *fail(lt_args *args, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(args->error, sizeof args->error, fmt, ap);
-    va_end(ap);
-    return args->error;
-}
+/* The parse's error: the message in args->error, returned. */
+#define fail(args, ...) sp_format((args)->error, sizeof (args)->error, __VA_ARGS__)
 
 static int is_space(char c)
 {

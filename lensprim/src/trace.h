@@ -21,6 +21,13 @@ lp_status lp__args_resolve(const lp_trace_args *args, lp_trace_args *out, lp_err
 /* Does the application want an outgoing ray?  Applies flags and filter. */
 int lp__args_keep(const lp_trace_args *a, const lp_branch_info *info);
 
+/* The branch of the given depth, kind and surface leaving the lens's
+ * local point p along the local direction dir with this bound, as the
+ * application sees it (*info, in world space); nonzero when the flags and
+ * filter keep it (lp__args_keep). */
+int lp__branch_keep(const lp_lens *lens, const lp_trace_args *a, int depth, lp_kind kind,
+                    int surface, lp_vec3 p, lp_vec3 dir, double bound, lp_branch_info *info);
+
 /* The payload an outgoing field continues with. */
 typedef struct lp__payload {
     double lambda_nm;

@@ -102,12 +102,15 @@ static double node_weight(const lp__node *nd, lp_mode mode, int reflect)
 static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
                       uint64_t path, double op, double bound, double weight)
 {
-    const lp_lens *lens = bw->lens;
     lp_query *q = &bw->query[bw->n_queries];
     lp_branch_info info;
 
-    q->origin = lp__to_world_point(lens, bw->node[depth].p);
-    q->dir = lp__to_world_dir(lens, dir);
+    if (bound < bw->args.min_weight ||
+        !lp__branch_keep(bw->lens, &bw->args, depth, kind, surface, bw->node[depth].p, dir,
+                         bound, &info))
+        return;
+    q->origin = info.origin;
+    q->dir = info.dir;
     q->depth = depth;
     q->kind = kind;
     q->surface = surface;
@@ -116,16 +119,6 @@ static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_
     q->bound = bound;
     q->weight = weight;
     q->waves = 0;
-    if (bound < bw->args.min_weight)
-        return;
-    info.depth = depth;
-    info.kind = kind;
-    info.surface = surface;
-    info.origin = q->origin;
-    info.dir = q->dir;
-    info.bound = bound;
-    if (!lp__args_keep(&bw->args, &info))
-        return;
     bw->query_dir[bw->n_queries] = dir;
     bw->n_queries++;
 }

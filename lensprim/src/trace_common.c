@@ -77,6 +77,18 @@ int lp__args_keep(const lp_trace_args *a, const lp_branch_info *info)
     return a->filter ? a->filter(info, a->user) != 0 : 1;
 }
 
+int lp__branch_keep(const lp_lens *lens, const lp_trace_args *a, int depth, lp_kind kind,
+                    int surface, lp_vec3 p, lp_vec3 dir, double bound, lp_branch_info *info)
+{
+    info->depth = depth;
+    info->kind = kind;
+    info->surface = surface;
+    info->origin = lp__to_world_point(lens, p);
+    info->dir = lp__to_world_dir(lens, dir);
+    info->bound = bound;
+    return lp__args_keep(a, info);
+}
+
 int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
 {
     lp_vec3 w = v3_sub(v, v3_scale(d, v3_dot(v, d)));
@@ -127,13 +139,7 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
     lp_branch_info info;
     double power = cv3_norm2(b->E);
 
-    info.depth = depth;
-    info.kind = kind;
-    info.surface = surface;
-    info.origin = lp__to_world_point(lens, p);
-    info.dir = lp__to_world_dir(lens, b->dir);
-    info.bound = power;
-    if (!lp__args_keep(a, &info)) {
+    if (!lp__branch_keep(lens, a, depth, kind, surface, p, b->dir, power, &info)) {
         res->skipped += power;
         return LP_OK;
     }

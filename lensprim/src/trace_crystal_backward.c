@@ -89,17 +89,10 @@ static int add_node(lp__xback *x, const xnode_rec *r)
 static int add_query(lp__xback *x, int node, lp_kind kind, int surface, lp_vec3 dir,
                      uint64_t path, uint64_t waves, double op, double bound, double weight)
 {
-    const lp_lens *lens = x->lens;
     lp_branch_info info;
-    if (bound < x->args.min_weight)
-        return 0;
-    info.depth = x->node[node].depth;
-    info.kind = kind;
-    info.surface = surface;
-    info.origin = lp__to_world_point(lens, x->node[node].p);
-    info.dir = lp__to_world_dir(lens, dir);
-    info.bound = bound;
-    if (!lp__args_keep(&x->args, &info))
+    if (bound < x->args.min_weight ||
+        !lp__branch_keep(x->lens, &x->args, x->node[node].depth, kind, surface, x->node[node].p,
+                         dir, bound, &info))
         return 0;
     if (x->n_queries == x->cap_queries) {
         size_t cap = x->cap_queries ? 2 * x->cap_queries : 16;

@@ -23,6 +23,7 @@
 #include "support/cli.h"
 #include "support/colorimetry.h"
 #include "support/image.h"
+#include "support/vec.h"
 
 #define EXIT_USAGE 2
 #define PI 3.14159265358979323846
@@ -174,22 +175,11 @@ static void spectrum_init(spectrum *sp, double mono_nm)
 /* Tracing natural light                                               */
 /* ------------------------------------------------------------------ */
 
-static lp_vec3 v3(double x, double y, double z)
-{
-    lp_vec3 v = {x, y, z};
-    return v;
-}
-
-static lp_vec3 cross(lp_vec3 a, lp_vec3 b)
-{
-    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
-}
-
 /* A unit vector perpendicular to the unit vector d. */
 static lp_vec3 perpendicular(lp_vec3 d)
 {
     lp_vec3 a = fabs(d.x) < 0.6 ? v3(1, 0, 0) : v3(0, 1, 0);
-    lp_vec3 u = cross(d, a);
+    lp_vec3 u = v3_cross(d, a);
     double n = sqrt(u.x * u.x + u.y * u.y + u.z * u.z);
     return v3(u.x / n, u.y / n, u.z / n);
 }
@@ -215,7 +205,7 @@ static int trace_natural(tracer *t, const lp_lens *lens, lp_vec3 o, lp_vec3 d, d
     in.lambda_nm = lambda;
     in.intensity = 1.0 / halves;
     for (int h = 0; h < halves; h++) {
-        in.vp = h == 0 ? u : cross(d, u);
+        in.vp = h == 0 ? u : v3_cross(d, u);
         in.ch = (uint64_t)h;
         if (lp_trace_forward(lens, &in, &t->args, &t->res, err) != LP_OK)
             return -1;
@@ -1085,8 +1075,7 @@ static int parse_args(int argc, char **argv, options *op)
         const char *a = argv[i], *v = NULL;
         char name[32];
         if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-            for (size_t j = 0; j < sizeof usage_text / sizeof *usage_text; j++)
-                fputs(usage_text[j], stdout);
+            (void)sp_print_text(usage_text, sizeof usage_text / sizeof *usage_text);
             return 1;
         }
         const char *eq = strchr(a, '=');

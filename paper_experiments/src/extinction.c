@@ -6,9 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "library_path.h"
-#include "parser.h"
-#include "scene.h"
+#include "lensrender/lensrender.h"
 
 #define EXT_PI 3.14159265358979323846
 
@@ -33,29 +31,27 @@ void ext_system_free(ext_system *sys)
 int ext_system_from_scene(const char *path, double lambda_nm, ext_system *sys, char *msg,
                           size_t msg_size)
 {
-    rs_scene sc;
-    rs_parse_opts po;
-    const char *dirs[4];
+    lr_scene *scene = NULL;
+    lr_error err;
+    const rs_scene *sc = NULL;
     const rs_object *pol[2] = {NULL, NULL};
     int n_pol = 0, rc = -1;
 
     memset(sys, 0, sizeof *sys);
     sys->lambda_nm = lambda_nm;
-    rs_scene_init(&sc);
-    rs_parse_opts_init(&po);
-    po.include_dirs = dirs;
-    po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
-    if (rs_parse_file(path, &po, &sc, msg, msg_size) != 0 ||
-        rs_scene_prepare(&sc, msg, msg_size) != 0)
+    if (lr_scene_load(path, NULL, &scene, &err) != LR_OK) {
+        snprintf(msg, msg_size, "%s", err.message);
         goto done;
-    for (size_t j = 0; j < sc.n_objects; j++)
-        if (sc.objects[j].type == RS_OBJ_POLARIZER && n_pol++ < 2)
-            pol[n_pol - 1] = &sc.objects[j];
+    }
+    sc = lr_scene_description(scene);
+    for (size_t j = 0; j < sc->n_objects; j++)
+        if (sc->objects[j].type == RS_OBJ_POLARIZER && n_pol++ < 2)
+            pol[n_pol - 1] = &sc->objects[j];
     if (n_pol != 2) {
         snprintf(msg, msg_size, "%s: %d polarizers; an instrument has two", path, n_pol);
         goto done;
     }
-    lp_vec3 cam = sc.camera.location;
+    lp_vec3 cam = sc->camera.location;
     double z0 = pol[0]->u.polarizer.center.z, z1 = pol[1]->u.polarizer.center.z;
     int first = fabs(z0 - cam.z) > fabs(z1 - cam.z) ? 0 : 1;
     const rs_object *P = pol[first], *A = pol[1 - first];
@@ -75,8 +71,8 @@ int ext_system_from_scene(const char *path, double lambda_nm, ext_system *sys, c
     sys->z_start = P->u.polarizer.center.z;
     sys->dir_z = A->u.polarizer.center.z < sys->z_start ? -1.0 : 1.0;
     double zlo = fmin(z0, z1), zhi = fmax(z0, z1);
-    for (size_t j = 0; j < sc.n_objects; j++) {
-        const rs_object *o = &sc.objects[j];
+    for (size_t j = 0; j < sc->n_objects; j++) {
+        const rs_object *o = &sc->objects[j];
         if (o->type != RS_OBJ_LENS)
             continue;
         lp_lens_desc d;
@@ -92,9 +88,9 @@ int ext_system_from_scene(const char *path, double lambda_nm, ext_system *sys, c
             snprintf(msg, msg_size, "%s: more than %d lenses", path, EXT_LENS_MAX);
             goto done;
         }
-        lp_error err;
-        if (lp_lens_create(&d, &sys->lens[sys->n], &err) != LP_OK) {
-            snprintf(msg, msg_size, "%s: %s", path, err.message);
+        lp_error lerr;
+        if (lp_lens_create(&d, &sys->lens[sys->n], &lerr) != LP_OK) {
+            snprintf(msg, msg_size, "%s: %s", path, lerr.message);
             goto done;
         }
         sys->n++;
@@ -107,7 +103,7 @@ int ext_system_from_scene(const char *path, double lambda_nm, ext_system *sys, c
 done:
     if (rc != 0)
         ext_system_free(sys);
-    rs_scene_free(&sc);
+    lr_scene_free(scene);
     return rc;
 }
 

@@ -17,9 +17,7 @@
 
 #include "experiments.h"
 #include "plot.h"
-#include "library_path.h"
-#include "parser.h"
-#include "scene.h"
+#include "lensrender/lensrender.h"
 
 #define EXIT_USAGE 2
 
@@ -148,28 +146,24 @@ static int load_lenses(ex_ctx *ctx, const char *dir)
     closedir(d);
     qsort(names, n, sizeof names[0], cmp_str);
     for (size_t i = 0; i < n && rc == 0; i++) {
-        char path[4096], msg[512];
-        rs_scene scene;
+        char path[4096];
+        lr_scene *sc = NULL;
+        lr_error err;
         snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-        rs_scene_init(&scene);
-        /* prepare: the lenses get their catalog glass (the parser keeps only
-         * the name) */
-        const char *dirs[4];
-        rs_parse_opts po;
-        rs_parse_opts_init(&po);
-        po.include_dirs = dirs; /* POV-Ray's colors.inc ..., as lensrender */
-        po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
-        if (rs_parse_file(path, &po, &scene, msg, sizeof msg) != 0 ||
-            rs_scene_prepare(&scene, msg, sizeof msg) != 0) {
-            snprintf(ctx->msg, sizeof ctx->msg, "%s", msg);
+        /* loaded as lensrender loads it (POV-Ray's colors.inc ... found):
+         * the lenses have their catalog glass (the reader keeps only the
+         * name) */
+        if (lr_scene_load(path, NULL, &sc, &err) != LR_OK) {
+            snprintf(ctx->msg, sizeof ctx->msg, "%.*s", (int)sizeof ctx->msg - 1, err.message);
             rc = -1;
         }
+        const rs_scene *scene = lr_scene_description(sc);
         int k = 0, count = 0;
         /* the paper's lens is of glass: crystal specimens are left out */
-        for (size_t j = 0; rc == 0 && j < scene.n_objects; j++)
-            count += scene.objects[j].type == RS_OBJ_LENS && !scene.objects[j].u.lens.desc.uniaxial;
-        for (size_t j = 0; rc == 0 && j < scene.n_objects; j++) {
-            const rs_object *o = &scene.objects[j];
+        for (size_t j = 0; rc == 0 && j < scene->n_objects; j++)
+            count += scene->objects[j].type == RS_OBJ_LENS && !scene->objects[j].u.lens.desc.uniaxial;
+        for (size_t j = 0; rc == 0 && j < scene->n_objects; j++) {
+            const rs_object *o = &scene->objects[j];
             if (o->type != RS_OBJ_LENS || o->u.lens.desc.uniaxial || ctx->n_lens >= EX_LENS_MAX)
                 continue;
             ex_lens *l = &ctx->lens[ctx->n_lens++];
@@ -185,7 +179,7 @@ static int load_lenses(ex_ctx *ctx, const char *dir)
             snprintf(l->glass, sizeof l->glass, "%s",
                      o->u.lens.glass_name[0] ? o->u.lens.glass_name : l->desc.glass.name);
         }
-        rs_scene_free(&scene);
+        lr_scene_free(sc);
     }
     for (size_t i = 0; i < n; i++)
         free(names[i]);

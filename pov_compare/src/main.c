@@ -21,24 +21,19 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "camera.h"
 #include "compare.h"
-#include "support/cli.h"
-#include "support/image.h"
-#include "integrator.h"
-#include "library_path.h"
+#include "lensrender/lensrender.h"
 #include "montage.h"
-#include "parser.h"
 #include "povray.h"
 #include "report.h"
-#include "scene.h"
+#include "support/cli.h"
+#include "support/image.h"
 #include "support/tiles.h"
 #include "translate.h"
 
 #define EXIT_RENDER 1
 #define EXIT_BAD 2
 #define MSG_MAX (2 * PATH_MAX + 1024)
-#define TILE_SIZE 16
 #define SIZE_MAX_SIDE 16384
 #define PIXELS_MAX (64LL * 1024 * 1024)
 #define DEPTH_MAX 256
@@ -355,74 +350,48 @@ static int find_lens_inc(const options *o, const char *scene_path, char *out, si
 
 /* ---- our renders ---- */
 
-typedef struct render_ctx {
-    const rs_integrator *it;
-    rs_image *img;
-} render_ctx;
-
-static void *worker_make(void *user)
-{
-    const render_ctx *c = user;
-    return rs_worker_create(c->it);
-}
-
-static void worker_free(void *worker)
-{
-    rs_worker_destroy(worker);
-}
-
-static void render_tile(void *user, void *worker, int x0, int y0, int x1, int y1)
-{
-    const render_ctx *c = user;
-    for (int j = y0; j < y1; j++)
-        for (int i = x0; i < x1; i++) {
-            rs_color col;
-            float *px = c->img->rgb + 3 * ((size_t)j * (size_t)c->img->width + (size_t)i);
-            rs_integrator_pixel(c->it, worker, i, j, &col);
-            px[0] = (float)col.r;
-            px[1] = (float)col.g;
-            px[2] = (float)col.b;
-        }
-}
-
-/* Render scene in mode into *img (created here); *seconds = wall clock. */
-static int render_ours(const rs_scene *scene, rs_mode mode, int width, int height, int depth,
+/* Render the scene in mode into *img (created here), with the
+ * approximations of the translation (no dispersion: the scene's glass is
+ * frozen at the d line by the first render); *seconds = wall clock. */
+static int render_ours(lr_scene *scene, lr_mode mode, int width, int height, int depth,
                        int threads, rs_image *img, double *seconds, char *msg, size_t msg_size)
 {
-    rs_render_opts ro;
-    rs_integrator *it = NULL;
+    lr_render_opts ro;
+    lr_renderer *r = NULL;
+    lr_error err;
     double t0 = sp_now_seconds();
 
-    rs_render_opts_init(&ro);
+    lr_render_opts_init(&ro);
     ro.mode = mode;
     ro.depth = depth;
     ro.cutoff = 0.0;            /* POV-Ray runs with adc_bailout 0 */
     ro.wavelengths = WAVELENGTHS;
     ro.width = width;
     ro.height = height;
-    if (rs_integrator_create(scene, &ro, &it, msg, msg_size) != 0)
+    ro.no_dispersion = 1;
+    ro.threads = threads;
+    if (lr_renderer_create(scene, &ro, &r, &err) != LR_OK) {
+        snprintf(msg, msg_size, "%s", err.message);
         return -1;
+    }
     if (rs_image_create(img, width, height) != 0) {
-        rs_integrator_destroy(it);
+        lr_renderer_free(r);
         snprintf(msg, msg_size, "out of memory for a %d x %d image", width, height);
         return -1;
     }
-    render_ctx ctx = {it, img};
-    int rc = rs_render_tiles(width, height, TILE_SIZE, threads, worker_make, worker_free,
-                             render_tile, &ctx, -1);
-    rs_integrator_destroy(it);
+    lr_status st = lr_render_image(r, img->rgb, NULL, NULL, &err);
+    lr_renderer_free(r);
     *seconds = sp_now_seconds() - t0;
-    if (rc != 0) {
+    if (st != LR_OK) {
         rs_image_free(img);
-        snprintf(msg, msg_size, "the %s render failed (out of memory for a worker thread)",
-                 pc_mode_label(mode));
+        snprintf(msg, msg_size, "the %s render failed: %s", pc_mode_label(mode), err.message);
         return -1;
     }
     return 0;
 }
 
 /* Our silhouette: 1 where the pixel-centre ray hits any lens. */
-static unsigned char *our_mask(const rs_scene *scene, const rs_view *view, int w, int h)
+static unsigned char *our_mask(const rs_scene *scene, int w, int h)
 {
     unsigned char *m = calloc((size_t)w * (size_t)h, 1);
     if (!m)
@@ -430,7 +399,10 @@ static unsigned char *our_mask(const rs_scene *scene, const rs_view *view, int w
     for (int j = 0; j < h; j++)
         for (int i = 0; i < w; i++) {
             lp_vec3 o, d;
-            rs_camera_ray(view, i + 0.5, j + 0.5, w, h, &o, &d);
+            if (lr_camera_ray(&scene->camera, w, h, i + 0.5, j + 0.5, &o, &d, NULL) != LR_OK) {
+                free(m);
+                return NULL;
+            }
             for (size_t k = 0; k < scene->n_objects; k++) {
                 const rs_object *ob = &scene->objects[k];
                 lp_hit hit;
@@ -468,7 +440,7 @@ static int path_in(char *buf, size_t size, const char *dir, const char *name)
 }
 
 typedef struct run_state {
-    rs_scene scene;
+    lr_scene *scene;
     pc_notes notes;
     rs_image pov, pov_mask, ours[PC_N_MODES], diff;
     unsigned char *mask_a, *mask_b;
@@ -476,7 +448,7 @@ typedef struct run_state {
 
 static void run_state_free(run_state *s)
 {
-    rs_scene_free(&s->scene);
+    lr_scene_free(s->scene);
     pc_notes_free(&s->notes);
     rs_image_free(&s->pov);
     rs_image_free(&s->pov_mask);
@@ -501,9 +473,10 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
 {
     char msg[MSG_MAX] = "", path[PATH_MAX], lens_inc[PATH_MAX], log_path[PATH_MAX];
     run_state st;
-    rs_parse_opts popts;
-    const char *dirs[4];
-    rs_view view;
+    lr_load_opts lo;
+    lr_error err;
+    lp_vec3 ray_o, ray_d;
+    const rs_scene *desc = NULL;
     pc_report *rep = &sum->rep;
     int status = 0, w = o->width, h = o->height;
     int threads = o->threads > 0 ? o->threads : rs_online_processors();
@@ -511,12 +484,9 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
     memset(&st, 0, sizeof st);
     memset(sum, 0, sizeof *sum);
     scene_name(scene_path, sum->name, sizeof sum->name);
-    rs_scene_init(&st.scene);
-    rs_parse_opts_init(&popts);
-    popts.image_width = w;
-    popts.image_height = h;
-    popts.include_dirs = dirs;
-    popts.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
+    lr_load_opts_init(&lo);
+    lo.image_width = w;
+    lo.image_height = h;
 
 #define FAIL(code, ...)                                                                        \
     do {                                                                                       \
@@ -526,19 +496,18 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
         goto done;                                                                             \
     } while (0)
 
-    if (rs_parse_file(scene_path, &popts, &st.scene, msg, sizeof msg) != 0)
-        FAIL(EXIT_BAD, "%s", msg);
-    if (rs_scene_prepare(&st.scene, msg, sizeof msg) != 0)
-        FAIL(EXIT_BAD, "%s", msg);
-    if (rs_camera_setup(&st.scene.camera, w, h, &view, msg, sizeof msg) != 0)
-        FAIL(EXIT_BAD, "%s: camera: %s", scene_path, msg);
+    if (lr_scene_load(scene_path, &lo, &st.scene, &err) != LR_OK)
+        FAIL(EXIT_BAD, "%s", err.message);
+    desc = lr_scene_description(st.scene);
+    if (lr_camera_ray(&desc->camera, w, h, 0.5, 0.5, &ray_o, &ray_d, &err) != LR_OK)
+        FAIL(EXIT_BAD, "%s: camera: %s", scene_path, err.message);
     if (sp_mkdir_p(out_dir, msg, sizeof msg) != 0)
         FAIL(EXIT_BAD, "%s", msg);
 
     rep->scene = base_of(scene_path);
     rep->width = w;
     rep->height = h;
-    rep->depth = o->depth > 0 ? o->depth : st.scene.settings.max_trace_level;
+    rep->depth = o->depth > 0 ? o->depth : desc->settings.max_trace_level;
     rep->wavelengths = WAVELENGTHS;
     rep->notes = &st.notes;
     for (int k = 0; k < PC_N_MODES; k++)
@@ -560,7 +529,7 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
     for (int mask = 0; mask <= 1; mask++) {
         pc_translate_opts to = {w, h, rep->depth, "lens.inc", mask};
         if (path_in(path, sizeof path, out_dir, mask ? "mask.pov" : "scene.pov") ||
-            pc_povray_write_scene(&st.scene, &to, path, &st.notes, msg, sizeof msg) != 0)
+            pc_povray_write_scene(desc, &to, path, &st.notes, msg, sizeof msg) != 0)
             FAIL(EXIT_RENDER, "%s", msg[0] ? msg : "output path too long");
     }
     if (path_in(log_path, sizeof log_path, out_dir, "povray.log"))
@@ -590,15 +559,13 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
     }
     pc_povray_version_from_log(log_path, rep->povray_version, sizeof rep->povray_version);
 
-    /* Our side: the same approximations, then every mode. */
-    if (rs_scene_freeze_glass(&st.scene, RS_LAMBDA_D_LINE, msg, sizeof msg) != 0)
-        FAIL(EXIT_BAD, "%s", msg);
+    /* Our side: the same approximations (no dispersion), then every mode. */
     for (int k = 0; k < PC_N_MODES; k++) {
-        rs_mode mode = rep->modes[k].mode;
+        lr_mode mode = rep->modes[k].mode;
         char name[64], stage[64];
         snprintf(stage, sizeof stage, "ours: %s", pc_mode_label(mode));
         progress(o, rep->scene, stage);
-        if (render_ours(&st.scene, mode, w, h, rep->depth, threads, &st.ours[k],
+        if (render_ours(st.scene, mode, w, h, rep->depth, threads, &st.ours[k],
                         &rep->modes[k].seconds, msg, sizeof msg) != 0)
             FAIL(EXIT_RENDER, "%s: %s", scene_path, msg);
         snprintf(name, sizeof name, "ours_%s.png", pc_mode_label(mode));
@@ -612,7 +579,7 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
     }
 
     /* Silhouettes. */
-    st.mask_a = our_mask(&st.scene, &view, w, h);
+    st.mask_a = our_mask(desc, w, h);
     st.mask_b = pc_mask_from_image(&st.pov_mask);
     if (!st.mask_a || !st.mask_b ||
         pc_compare_masks(st.mask_a, st.mask_b, w, h, &rep->geometry) != 0)
@@ -624,13 +591,13 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
     /* Metrics. */
     const rs_image *pol = NULL;
     for (int k = 0; k < PC_N_MODES; k++)
-        if (rep->modes[k].mode == RS_MODE_POLARIZED)
+        if (rep->modes[k].mode == LR_MODE_POLARIZED)
             pol = &st.ours[k];
     for (int k = 0; k < PC_N_MODES; k++) {
         pc_mode_result *m = &rep->modes[k];
         pc_compare_images(&st.ours[k], &st.pov, &m->vs_povray);
         pc_worst_pixel_find(&st.ours[k], &st.pov, &m->worst);
-        m->has_vs_polarized = m->mode != RS_MODE_POLARIZED;
+        m->has_vs_polarized = m->mode != LR_MODE_POLARIZED;
         if (m->has_vs_polarized)
             pc_compare_images(&st.ours[k], pol, &m->vs_polarized);
     }
@@ -667,7 +634,7 @@ static int compare_scene(const options *o, const char *scene_path, const char *o
         FAIL(EXIT_RENDER, "%s", msg);
 
     if (!o->quiet) {
-        const pc_mode_result *p = pc_report_find(rep, RS_MODE_POLARIZED);
+        const pc_mode_result *p = pc_report_find(rep, LR_MODE_POLARIZED);
         printf("%s: IoU %.5f, boundary %.3g px; vs POV-Ray PSNR fresnel %.2f, schlick %.2f, "
                "polarized %.2f, rgb %.2f dB; POV-Ray %.2f s, ours %.2f/%.2f/%.2f/%.2f s -> %s/\n",
                rep->scene, rep->geometry.iou, rep->geometry.max_boundary_px, fr->vs_povray.psnr,
@@ -950,8 +917,8 @@ int main(int argc, char **argv)
     if (parse_args(argc, argv, &o) != 0)
         return EXIT_BAD;
     if (o.help) {
-        fputs(usage_text, stdout);
-        return fflush(stdout) == 0 ? 0 : EXIT_RENDER;
+        const char *text = usage_text;
+        return sp_print_text(&text, 1) == 0 ? 0 : EXIT_RENDER;
     }
     if (o.all)
         return compare_all(&o);

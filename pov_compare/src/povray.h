@@ -19,7 +19,7 @@
 #include <stddef.h>
 
 #include "support/image.h"
-#include "scene.h"
+#include "lensrender/scene.h"
 #include "translate.h"
 
 /* What went wrong in a render. */

@@ -8,26 +8,20 @@
 
 #include "report.h"
 
-static const rs_mode order[PC_N_MODES] = {RS_MODE_FRESNEL, RS_MODE_SCHLICK, RS_MODE_POLARIZED,
-                                          RS_MODE_RGB};
+static const lr_mode order[PC_N_MODES] = {LR_MODE_FRESNEL, LR_MODE_SCHLICK, LR_MODE_POLARIZED,
+                                          LR_MODE_RGB};
 
-rs_mode pc_report_mode(int k)
+lr_mode pc_report_mode(int k)
 {
     return order[k >= 0 && k < PC_N_MODES ? k : 0];
 }
 
-const char *pc_mode_label(rs_mode mode)
+const char *pc_mode_label(lr_mode mode)
 {
-    switch (mode) {
-    case RS_MODE_POLARIZED: return "polarized";
-    case RS_MODE_FRESNEL: return "fresnel";
-    case RS_MODE_SCHLICK: return "schlick";
-    case RS_MODE_RGB: return "rgb";
-    }
-    return "?";
+    return lr_mode_name(mode);
 }
 
-const pc_mode_result *pc_report_find(const pc_report *r, rs_mode mode)
+const pc_mode_result *pc_report_find(const pc_report *r, lr_mode mode)
 {
     for (int k = 0; k < PC_N_MODES; k++)
         if (r->modes[k].mode == mode)
@@ -255,7 +249,7 @@ int pc_report_write_md(const pc_report *r, const char *path, char *msg, size_t m
                "([ours](mask_ours.png), [POV-Ray](mask_povray.png)).\n\n",
             g->iou, g->max_boundary_px, g->flipped, g->area_a, g->area_b);
 
-    const pc_mode_result *fr = pc_report_find(r, RS_MODE_FRESNEL);
+    const pc_mode_result *fr = pc_report_find(r, LR_MODE_FRESNEL);
     if (fr)
         fprintf(f, "**Largest difference** (fresnel against POV-Ray, luminance): pixel "
                    "(%d, %d), ours %.5f, POV-Ray %.5f.\n\n",

@@ -24,14 +24,14 @@
 #include <stdio.h>
 
 #include "compare.h"
-#include "integrator.h"
+#include "lensrender/lensrender.h"
 #include "translate.h"
 
 #define PC_N_MODES 4
 
 /* One of our light models against POV-Ray (and against polarized). */
 typedef struct pc_mode_result {
-    rs_mode mode;
+    lr_mode mode;
     pc_metrics vs_povray;
     pc_metrics vs_polarized;   /* not for the polarized mode itself */
     int has_vs_polarized;
@@ -54,11 +54,11 @@ typedef struct pc_report {
 } pc_report;
 
 /* The order of modes in reports: fresnel, schlick, polarized, rgb. */
-rs_mode pc_report_mode(int k);
-const char *pc_mode_label(rs_mode mode); /* "fresnel", ... */
+lr_mode pc_report_mode(int k);
+const char *pc_mode_label(lr_mode mode); /* "fresnel", ... */
 
 /* The result of mode in r, or NULL. */
-const pc_mode_result *pc_report_find(const pc_report *r, rs_mode mode);
+const pc_mode_result *pc_report_find(const pc_report *r, lr_mode mode);
 
 /* Write report.json / report.md.  Return 0, or -1 with a message. */
 int pc_report_write_json(const pc_report *r, const char *path, char *msg, size_t msg_size);

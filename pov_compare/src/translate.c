@@ -32,9 +32,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "camera.h"
-#include "csg.h"
-#include "emitter.h"
+#include "lensrender/lensrender.h"
+#include "support/vec.h"
 
 #define PC_PI 3.14159265358979323846
 /* pc_pov_scale's largest factor.  Rays bent by a lens can travel far
@@ -103,28 +102,6 @@ static int fail_at(char *msg, size_t msg_size, const rs_loc *loc, const char *wh
     return fail(msg, msg_size, "%s", what);
 }
 
-static int vec_finite(lp_vec3 v)
-{
-    return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
-}
-
-static int color_finite(rs_color c)
-{
-    return isfinite(c.r) && isfinite(c.g) && isfinite(c.b);
-}
-
-static int xf_finite(const rs_transform *xf)
-{
-    for (int i = 0; i < 3; i++) {
-        if (!isfinite(xf->t[i]) || !isfinite(xf->inv_t[i]))
-            return 0;
-        for (int j = 0; j < 3; j++)
-            if (!isfinite(xf->m[i][j]) || !isfinite(xf->inv_m[i][j]))
-                return 0;
-    }
-    return 1;
-}
-
 static int xf_is_identity(const rs_transform *xf)
 {
     for (int i = 0; i < 3; i++) {
@@ -190,32 +167,6 @@ static void put_matrix(FILE *out, const rs_transform *xf, double k)
             fputs(", ", out);
     }
     fputc('>', out);
-}
-
-static lp_vec3 v3_scale(lp_vec3 v, double k)
-{
-    return (lp_vec3){ k * v.x, k * v.y, k * v.z };
-}
-
-static lp_vec3 v3_sub(lp_vec3 a, lp_vec3 b)
-{
-    return (lp_vec3){ a.x - b.x, a.y - b.y, a.z - b.z };
-}
-
-static double v3_dot(lp_vec3 a, lp_vec3 b)
-{
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-
-static lp_vec3 v3_cross(lp_vec3 a, lp_vec3 b)
-{
-    return (lp_vec3){ a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x };
-}
-
-static lp_vec3 v3_unit(lp_vec3 a)
-{
-    double l = sqrt(v3_dot(a, a));
-    return (lp_vec3){ a.x / l, a.y / l, a.z / l };
 }
 
 /* ---- lenses ------------------------------------------------------------- */
@@ -302,7 +253,7 @@ static int pov_inside(const rs_object *o, lp_vec3 world)
 {
     if (o->type == RS_OBJ_DISC || o->type == RS_OBJ_LENS || o->type == RS_OBJ_POLARIZER)
         return -1;
-    return rs_object_inside(o, world) != o->inverse;
+    return lr_object_inside(o, world) != o->inverse;
 }
 
 static lp_vec3 camera_location(const rs_camera *cam)
@@ -368,44 +319,6 @@ static int note_straddling(const rs_scene *sc, const rs_object *o, pc_notes *not
 
 /* ---- lights --------------------------------------------------------------- */
 
-static rs_color clamp_nonneg(rs_color c)
-{
-    return (rs_color){ c.r > 0.0 ? c.r : 0.0, c.g > 0.0 ? c.g : 0.0, c.b > 0.0 ? c.b : 0.0 };
-}
-
-/* The RGB colour POV-Ray gets for a light: its colour for RGB spectra; for
- * a LINE the linear sRGB of the line's XYZ exactly as the renderer's
- * spectral modes add it (Y = luminance of the tint), for a BLACKBODY the
- * linear sRGB of its spectrum integrated at 1 nm over the renderer's band
- * (Y = luminance of the tint); negative components (out-of-gamut
- * colours) clipped to 0. */
-static rs_color light_rgb(const rs_light *l)
-{
-    rs_spectrum s = l->spectrum;
-    double xyz[3] = { 0.0, 0.0, 0.0 };
-    rs_color c;
-
-    s.rgb = l->color;
-    switch (s.type) {
-    case RS_SPECTRUM_LINE:
-        rs_spectrum_line_xyz(&s, xyz);
-        break;
-    case RS_SPECTRUM_BLACKBODY: {
-        double norm = rs_spectrum_norm(&s);
-        int n = (int)(RS_LAMBDA_MAX - RS_LAMBDA_MIN);
-        for (int i = 0; i < n; i++) {
-            double lambda = RS_LAMBDA_MIN + i + 0.5;
-            rs_xyz_accumulate(xyz, rs_spectrum_emission_norm(&s, norm, lambda), lambda, 1.0);
-        }
-        break;
-    }
-    default:
-        return l->color;
-    }
-    rs_xyz_to_linear_srgb(xyz, &c);
-    return clamp_nonneg(c);
-}
-
 /* ---- objects ---------------------------------------------------------- */
 
 static void put_pigment(FILE *out, const rs_object *o)
@@ -459,39 +372,6 @@ static void put_finish(FILE *out, const rs_finish *f)
     fputs(", ", out);
     put_rgb(out, f->reflection_max);
     fputs(f->fresnel ? " fresnel on } }\n" : " } }\n", out);
-}
-
-static int check_object(const rs_object *o)
-{
-    if (!xf_finite(&o->xf) || !color_finite(o->pigment.color[0]) ||
-        !color_finite(o->pigment.color[1]) || !xf_finite(&o->pigment.to_pattern) ||
-        !color_finite(o->finish.ambient) || !color_finite(o->finish.emission) ||
-        !isfinite(o->finish.diffuse) || !isfinite(o->finish.brilliance) ||
-        !isfinite(o->finish.phong) || !isfinite(o->finish.phong_size) ||
-        !isfinite(o->finish.specular) || !isfinite(o->finish.roughness) ||
-        !color_finite(o->finish.reflection_min) || !color_finite(o->finish.reflection_max) ||
-        !isfinite(o->ior))
-        return -1;
-    switch (o->type) {
-    case RS_OBJ_PLANE:
-        return vec_finite(o->u.plane.normal) && isfinite(o->u.plane.distance) ? 0 : -1;
-    case RS_OBJ_SPHERE:
-        return vec_finite(o->u.sphere.center) && isfinite(o->u.sphere.radius) ? 0 : -1;
-    case RS_OBJ_BOX:
-        return vec_finite(o->u.box.corner1) && vec_finite(o->u.box.corner2) ? 0 : -1;
-    case RS_OBJ_DISC:
-        return vec_finite(o->u.disc.center) && vec_finite(o->u.disc.normal) &&
-                       isfinite(o->u.disc.radius) && isfinite(o->u.disc.hole)
-                   ? 0
-                   : -1;
-    case RS_OBJ_CSG:
-        for (size_t i = 0; i < o->u.csg.n_members; i++)
-            if (check_object(&o->u.csg.members[i]) != 0)
-                return -1;
-        return 0;
-    default:
-        return 0;
-    }
 }
 
 static void put_shape(FILE *out, const rs_object *o, int turn, const char *why, double k);
@@ -674,15 +554,6 @@ static int glass_absorbs(const lp_glass *g)
 
 /* ---- camera ------------------------------------------------------------- */
 
-static int camera_finite(const rs_camera *c)
-{
-    return vec_finite(c->location) && vec_finite(c->direction) && vec_finite(c->right) &&
-           vec_finite(c->up) && vec_finite(c->sky) && (!c->has_look_at || vec_finite(c->look_at)) &&
-           (!c->has_angle || isfinite(c->angle)) && (!c->has_xf || xf_finite(&c->xf));
-}
-
-/* The camera in a world magnified k times: points scale, directions do
- * not, and its transform M becomes S M S^-1 (translation times k). */
 static void put_camera(FILE *out, const rs_camera *c, double k)
 {
     /* POV-Ray applies these in its own fixed order (up, right, angle,
@@ -793,7 +664,7 @@ static int add_feature_notes(const rs_scene *sc, pc_notes *notes)
 /* Grow the box lo..hi by a point (non-finite points are ignored). */
 static void box_add(lp_vec3 *lo, lp_vec3 *hi, lp_vec3 p)
 {
-    if (!vec_finite(p))
+    if (!v3_finite(p))
         return;
     lo->x = fmin(lo->x, p.x);
     lo->y = fmin(lo->y, p.y);
@@ -815,19 +686,18 @@ static void box_add_xf(lp_vec3 *lo, lp_vec3 *hi, const rs_transform *xf, lp_vec3
 /* The farthest point where a primary ray meets a plane (0: none). */
 static double farthest_plane_hit(const rs_scene *scene, int width, int height)
 {
-    rs_view v;
     double far = 0.0;
     size_t n_planes = 0;
     for (size_t i = 0; i < scene->n_objects; i++)
         n_planes += scene->objects[i].type == RS_OBJ_PLANE;
     if (n_planes == 0)
         return 0.0;
-    if (rs_camera_setup(&scene->camera, width, height, &v, NULL, 0) != 0)
-        return INFINITY;
     for (int j = 0; j < height; j++)
         for (int i = 0; i < width; i++) {
             lp_vec3 o, d;
-            rs_camera_ray(&v, i + 0.5, j + 0.5, width, height, &o, &d);
+            if (lr_camera_ray(&scene->camera, width, height, i + 0.5, j + 0.5, &o, &d, NULL) !=
+                LR_OK)
+                return INFINITY;
             for (size_t k = 0; k < scene->n_objects; k++) {
                 const rs_object *ob = &scene->objects[k];
                 if (ob->type != RS_OBJ_PLANE)
@@ -952,39 +822,21 @@ int pc_translate_scaled(const rs_scene *scene, const pc_translate_opts *opts, do
     if (!path_writable(inc))
         return fail(msg, msg_size, "the lens.inc path cannot be written in a POV-Ray string: %s",
                     inc);
-    if (!color_finite(scene->background) || !color_finite(scene->settings.ambient_light))
-        return fail(msg, msg_size, "background or ambient_light is not finite");
-    if (!camera_finite(&scene->camera))
-        return fail(msg, msg_size, "camera: a value is not finite");
+    lr_error check;
+    if (lr_scene_check(scene, &check) != LR_OK)
+        return fail(msg, msg_size, "%s", check.message);
     size_t n_lenses = 0;
     for (size_t i = 0; i < scene->n_objects; i++) {
         const rs_object *o = &scene->objects[i];
-        if (o->type == RS_OBJ_LENS) {
-            const lp_lens_desc *d = &o->u.lens.desc;
-            lp_error err;
-            lp_lens *tmp = NULL;
-            if (o->lens == NULL) { /* not prepared: check it here */
-                if (lp_lens_create(d, &tmp, &err) != LP_OK)
-                    return fail_at(msg, msg_size, &o->loc, err.message);
-                lp_lens_destroy(tmp);
-            } else if (!vec_finite(d->position) || !vec_finite(d->axis) ||
-                       !isfinite(d->thickness) || !isfinite(d->diameter) ||
-                       !isfinite(d->diameter2)) {
-                return fail_at(msg, msg_size, &o->loc, "lens: a value is not finite");
-            }
-            double ng = lp_glass_index(&d->glass, RS_LAMBDA_D_LINE);
-            double nm = lp_glass_index(&d->medium, RS_LAMBDA_D_LINE);
-            if (!isfinite(ng) || !isfinite(nm) || !(ng > 0.0) || !(nm > 0.0))
-                return fail_at(msg, msg_size, &o->loc, "lens: no index at the d line");
-            n_lenses++;
-        } else if (check_object(o) != 0) {
-            return fail_at(msg, msg_size, &o->loc, "a value is not finite");
-        }
+        if (o->type != RS_OBJ_LENS)
+            continue;
+        const lp_lens_desc *d = &o->u.lens.desc;
+        double ng = lp_glass_index(&d->glass, RS_LAMBDA_D_LINE);
+        double nm = lp_glass_index(&d->medium, RS_LAMBDA_D_LINE);
+        if (!isfinite(ng) || !isfinite(nm) || !(ng > 0.0) || !(nm > 0.0))
+            return fail_at(msg, msg_size, &o->loc, "lens: no index at the d line");
+        n_lenses++;
     }
-    for (size_t i = 0; i < scene->n_lights; i++)
-        if (!vec_finite(scene->lights[i].position) || !color_finite(scene->lights[i].color))
-            return fail_at(msg, msg_size, &scene->lights[i].loc,
-                           "light_source: a value is not finite");
 
     lp_vec3 eye = camera_location(&scene->camera);
     if (!mask) {
@@ -1059,7 +911,7 @@ int pc_translate_scaled(const rs_scene *scene, const pc_translate_opts *opts, do
             fputs("light_source { ", out);
             put_vec(out, v3_scale(l->position, k));
             fputs(" color ", out);
-            put_rgb(out, light_rgb(l));
+            put_rgb(out, lr_light_rgb(l));
             fputs(" }\n", out);
         }
         if (scene->n_lights > 0)

@@ -17,14 +17,14 @@
  *   blackbody lights         the black body's colour as RGB
  *   light polarization       left out
  * The renderer is then run with the same approximations (see
- * rs_scene_freeze_glass) so that the two renders compare like with like. */
+ * lr_render_opts.no_dispersion) so that the two renders compare like with like. */
 #ifndef PC_TRANSLATE_H
 #define PC_TRANSLATE_H
 
 #include <stddef.h>
 #include <stdio.h>
 
-#include "scene.h"
+#include "lensrender/scene.h"
 
 /* The notes pc_translate adds, each at most once and only when the scene
  * has the feature (additions to the original API; the harness and tests

@@ -11,20 +11,10 @@
 #include <stdlib.h>
 #include <string.h>
 
-static const char *fail(rs_args *args, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
-#endif
-    ;
+#include "support/cli.h"
 
-static const char *fail(rs_args *args, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(args->error, sizeof args->error, fmt, ap);
-    va_end(ap);
-    return args->error;
-}
+/* The parse's error: the message in args->error, returned. */
+#define fail(args, ...) sp_format((args)->error, sizeof (args)->error, __VA_ARGS__)
 
 void rs_args_init(rs_args *args)
 {

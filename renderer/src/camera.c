@@ -6,61 +6,14 @@
 #include <stdarg.h>
 #include <stdio.h>
 
+#include "support/vec.h"
+
 /* POV-Ray's small number for its camera tests (EPSILON in its sources). */
 #define RS_CAMERA_EPSILON 1.0e-10
 /* Relative size under which D, R, U count as coplanar. */
 #define RS_CAMERA_COPLANAR 1.0e-12
 
 static const double rs_camera_pi = 3.14159265358979323846;
-
-static lp_vec3 v3(double x, double y, double z)
-{
-    lp_vec3 r = { x, y, z };
-    return r;
-}
-
-static lp_vec3 v_add(lp_vec3 a, lp_vec3 b)
-{
-    return v3(a.x + b.x, a.y + b.y, a.z + b.z);
-}
-
-static lp_vec3 v_sub(lp_vec3 a, lp_vec3 b)
-{
-    return v3(a.x - b.x, a.y - b.y, a.z - b.z);
-}
-
-static lp_vec3 v_scale(lp_vec3 a, double s)
-{
-    return v3(a.x * s, a.y * s, a.z * s);
-}
-
-static double v_dot(lp_vec3 a, lp_vec3 b)
-{
-    return a.x * b.x + a.y * b.y + a.z * b.z;
-}
-
-static lp_vec3 v_cross(lp_vec3 a, lp_vec3 b)
-{
-    return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z,
-              a.x * b.y - a.y * b.x);
-}
-
-static double v_len(lp_vec3 a)
-{
-    return sqrt(v_dot(a, a));
-}
-
-/* a / |a|; the caller has checked |a| > 0. */
-static lp_vec3 v_unit(lp_vec3 a)
-{
-    double l = v_len(a);
-    return v3(a.x / l, a.y / l, a.z / l);
-}
-
-static int v_finite(lp_vec3 a)
-{
-    return isfinite(a.x) && isfinite(a.y) && isfinite(a.z);
-}
 
 static int fail(char *msg, size_t msg_size, const char *fmt, ...)
 #if defined(__GNUC__)
@@ -85,13 +38,13 @@ static int check_frame(const rs_view *v, const char *when, char *msg,
                        size_t msg_size)
 {
     double ld, lr, lu, vol;
-    if (!v_finite(v->location) || !v_finite(v->D) || !v_finite(v->R) ||
-        !v_finite(v->U))
+    if (!v3_finite(v->location) || !v3_finite(v->D) || !v3_finite(v->R) ||
+        !v3_finite(v->U))
         return fail(msg, msg_size, "camera: the camera vectors are not finite%s",
                     when);
-    ld = v_len(v->D);
-    lr = v_len(v->R);
-    lu = v_len(v->U);
+    ld = v3_len(v->D);
+    lr = v3_len(v->R);
+    lu = v3_len(v->U);
     if (!(ld > 0.0))
         return fail(msg, msg_size, "camera: the direction vector is zero%s", when);
     if (!(lr > 0.0))
@@ -101,7 +54,7 @@ static int check_frame(const rs_view *v, const char *when, char *msg,
                     "camera: the up vector is zero%s (with look_at: the right "
                     "vector is parallel to the view direction; set sky)",
                     when);
-    vol = v_dot(v->D, v_cross(v->R, v->U));
+    vol = v3_dot(v->D, v3_cross(v->R, v->U));
     if (!(fabs(vol) > RS_CAMERA_COPLANAR * ld * lr * lu))
         return fail(msg, msg_size,
                     "camera: direction, right and up are coplanar%s, so the "
@@ -119,9 +72,9 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
     if (width < 1 || height < 1)
         return fail(msg, msg_size, "camera: image size %d x %d is not positive",
                     width, height);
-    if (!v_finite(cam->location) || !v_finite(cam->direction) ||
-        !v_finite(cam->right) || !v_finite(cam->up) || !v_finite(cam->sky) ||
-        (cam->has_look_at && !v_finite(cam->look_at)))
+    if (!v3_finite(cam->location) || !v3_finite(cam->direction) ||
+        !v3_finite(cam->right) || !v3_finite(cam->up) || !v3_finite(cam->sky) ||
+        (cam->has_look_at && !v3_finite(cam->look_at)))
         return fail(msg, msg_size, "camera: a camera vector is not finite");
 
     v.location = cam->location;
@@ -130,11 +83,11 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
     v.U = cam->up;
 
     /* 1. up and right as given. */
-    if (!(v_len(v.R) > 0.0))
+    if (!(v3_len(v.R) > 0.0))
         return fail(msg, msg_size, "camera: the right vector is zero");
-    if (!(v_len(v.U) > 0.0))
+    if (!(v3_len(v.U) > 0.0))
         return fail(msg, msg_size, "camera: the up vector is zero");
-    if (!(v_len(v.D) > 0.0))
+    if (!(v3_len(v.D) > 0.0))
         return fail(msg, msg_size, "camera: the direction vector is zero");
 
     /* 2. angle: the full horizontal field of view across right. */
@@ -151,32 +104,32 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
         if (cam->angle > 0.0) {
             double half = cam->angle * (rs_camera_pi / 360.0);
             /* evaluated in POV-Ray's order, for bit-equal vectors */
-            double dir_len = v_len(v.R) / tan(half) / 2.0;
-            v.D = v_scale(v_unit(v.D), dir_len);
+            double dir_len = v3_len(v.R) / tan(half) / 2.0;
+            v.D = v3_scale(v3_unit(v.D), dir_len);
         }
     }
 
     /* 3. look_at. */
     if (cam->has_look_at) {
-        double len_d = v_len(v.D), len_u = v_len(v.U), len_r = v_len(v.R);
+        double len_d = v3_len(v.D), len_u = v3_len(v.U), len_r = v3_len(v.R);
         /* The sign of the supplied frame: (U x D) . R > 0 for the default
          * camera, < 0 for a mirrored right. */
-        double handed = v_dot(v_cross(v.U, v.D), v.R);
-        lp_vec3 to = v_sub(cam->look_at, cam->location);
+        double handed = v3_dot(v3_cross(v.U, v.D), v.R);
+        lp_vec3 to = v3_sub(cam->look_at, cam->location);
         lp_vec3 d_hat, r_new, r_hat;
-        if (v_dot(to, to) < RS_CAMERA_EPSILON)
+        if (v3_dot(to, to) < RS_CAMERA_EPSILON)
             return fail(msg, msg_size,
                         "camera: location and look_at must be different");
-        d_hat = v_unit(to);
-        r_new = v_cross(cam->sky, d_hat);
+        d_hat = v3_unit(to);
+        r_new = v3_cross(cam->sky, d_hat);
         if (fabs(r_new.x) < RS_CAMERA_EPSILON &&
             fabs(r_new.y) < RS_CAMERA_EPSILON &&
             fabs(r_new.z) < RS_CAMERA_EPSILON)
             r_new = v.R; /* D parallel to sky: POV-Ray keeps the right */
-        r_hat = v_unit(r_new);
-        v.U = v_scale(v_cross(d_hat, r_hat), len_u);
-        v.D = v_scale(d_hat, len_d);
-        v.R = v_scale(r_hat, handed > 0.0 ? len_r : -len_r);
+        r_hat = v3_unit(r_new);
+        v.U = v3_scale(v3_cross(d_hat, r_hat), len_u);
+        v.D = v3_scale(d_hat, len_d);
+        v.R = v3_scale(r_hat, handed > 0.0 ? len_r : -len_r);
     }
 
     if (check_frame(&v, "", msg, msg_size) != 0)
@@ -196,8 +149,8 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
     /* 5. focal blur. */
     v.lens_radius = 0.0;
     v.focal_distance = 0.0;
-    v.lens_x = v_unit(v.R);
-    v.lens_y = v_unit(v.U);
+    v.lens_x = v3_unit(v.R);
+    v.lens_y = v3_unit(v.U);
     v.samples = 1;
     if (!isfinite(cam->aperture) || cam->aperture < 0.0)
         return fail(msg, msg_size, "camera: the aperture %g is not a finite size >= 0",
@@ -209,19 +162,19 @@ int rs_camera_setup(const rs_camera *cam, int width, int height,
                                    "is not supported");
     if (cam->aperture > 0.0) {
         lp_vec3 fp = cam->has_xf ? rs_xf_point(&cam->xf, cam->focal_point) : cam->focal_point;
-        lp_vec3 dh = v_unit(v.D), x;
-        if (!v_finite(fp))
+        lp_vec3 dh = v3_unit(v.D), x;
+        if (!v3_finite(fp))
             return fail(msg, msg_size, "camera: the focal point is not finite");
-        v.focal_distance = v_len(v_sub(fp, v.location));
-        if (!(v.focal_distance > RS_CAMERA_EPSILON * (1.0 + v_len(v.location))))
+        v.focal_distance = v3_len(v3_sub(fp, v.location));
+        if (!(v.focal_distance > RS_CAMERA_EPSILON * (1.0 + v3_len(v.location))))
             return fail(msg, msg_size,
                         "camera: with an aperture the focal point must differ from the "
                         "location");
-        x = v_sub(v.R, v_scale(dh, v_dot(v.R, dh)));
-        if (!(v_len(x) > 0.0))
-            x = v_sub(v.U, v_scale(dh, v_dot(v.U, dh)));
-        v.lens_x = v_unit(x);
-        v.lens_y = v_cross(dh, v.lens_x);
+        x = v3_sub(v.R, v3_scale(dh, v3_dot(v.R, dh)));
+        if (!(v3_len(x) > 0.0))
+            x = v3_sub(v.U, v3_scale(dh, v3_dot(v.U, dh)));
+        v.lens_x = v3_unit(x);
+        v.lens_y = v3_cross(dh, v.lens_x);
         v.lens_radius = 0.5 * cam->aperture;
         v.samples = cam->blur_samples > 0 ? cam->blur_samples : RS_CAMERA_BLUR_SAMPLES;
     }
@@ -236,13 +189,13 @@ void rs_camera_ray(const rs_view *v, double px, double py, int width,
     double x0 = px / (double)width - 0.5;
     double y0 = 0.5 - py / (double)height;
     if (v->orthographic) {
-        *origin = v_add(v_add(v->location, v_scale(v->R, x0)), v_scale(v->U, y0));
-        *dir = v_unit(v->D);
+        *origin = v3_add(v3_add(v->location, v3_scale(v->R, x0)), v3_scale(v->U, y0));
+        *dir = v3_unit(v->D);
         return;
     }
-    lp_vec3 d = v_add(v_add(v->D, v_scale(v->R, x0)), v_scale(v->U, y0));
+    lp_vec3 d = v3_add(v3_add(v->D, v3_scale(v->R, x0)), v3_scale(v->U, y0));
     *origin = v->location;
-    *dir = v_unit(d);
+    *dir = v3_unit(d);
 }
 
 void rs_camera_aperture_ray(const rs_view *v, double px, double py, int width,
@@ -258,10 +211,10 @@ void rs_camera_aperture_ray(const rs_view *v, double px, double py, int width,
         *dir = d;
         return;
     }
-    focus = v_add(o, v_scale(d, v->focal_distance));
+    focus = v3_add(o, v3_scale(d, v->focal_distance));
     r = v->lens_radius * sqrt((k + 0.5) / v->samples);
     phi = golden * k;
-    a = v_add(v_scale(v->lens_x, r * cos(phi)), v_scale(v->lens_y, r * sin(phi)));
-    *origin = v_add(o, a);
-    *dir = v_unit(v_sub(focus, *origin));
+    a = v3_add(v3_scale(v->lens_x, r * cos(phi)), v3_scale(v->lens_y, r * sin(phi)));
+    *origin = v3_add(o, a);
+    *dir = v3_unit(v3_sub(focus, *origin));
 }

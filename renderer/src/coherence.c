@@ -4,6 +4,8 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "support/vec.h"
+
 #define RS_COH_PI 3.14159265358979323846
 #define RS_COH_LOW 0xffffffffu
 
@@ -44,9 +46,6 @@ uint64_t rs_coherence_split(uint64_t ch, uint64_t hit, int depth, int transmit)
     return (ch & ~(uint64_t)0xffff0000u) | RS_COH_SPLIT | group << 16;
 }
 
-static double dot3(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static lp_vec3 sub3(lp_vec3 a, lp_vec3 b) { return (lp_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
-
 /* The difference of the wavelets' optical paths from the pair's common
  * source point (coherence.h); 0 with *ok = 0 when the pair has none. */
 static double wavelet_difference(const rs_wavelet *a, const rs_wavelet *b, int *ok)
@@ -58,25 +57,25 @@ static double wavelet_difference(const rs_wavelet *a, const rs_wavelet *b, int *
         *ok = 0;
         return 0.0;
     }
-    lp_vec3 dab = sub3(a->o, b->o);
+    lp_vec3 dab = v3_sub(a->o, b->o);
     if (a->finite) {
         /* |S - o_a| - |S - o_b| = (o_a - o_b).(o_a + o_b - 2S) / (|S - o_a| + |S - o_b|),
          * S = (s_a + s_b)/2: no cancellation of the two long distances. */
         lp_vec3 s = {0.5 * (a->s.x + b->s.x), 0.5 * (a->s.y + b->s.y), 0.5 * (a->s.z + b->s.z)};
-        lp_vec3 sa = sub3(s, a->o), sb = sub3(s, b->o);
-        double la = sqrt(dot3(sa, sa)), lb = sqrt(dot3(sb, sb));
+        lp_vec3 sa = v3_sub(s, a->o), sb = v3_sub(s, b->o);
+        double la = sqrt(v3_dot(sa, sa)), lb = sqrt(v3_dot(sb, sb));
         if (!(la + lb > 0.0))
             return 0.0;
         lp_vec3 m = {-(sa.x + sb.x), -(sa.y + sb.y), -(sa.z + sb.z)}; /* o_a + o_b - 2S */
-        return dot3(dab, m) / (la + lb);
+        return v3_dot(dab, m) / (la + lb);
     }
     lp_vec3 u = {a->d.x + b->d.x, a->d.y + b->d.y, a->d.z + b->d.z};
-    double lu = sqrt(dot3(u, u));
+    double lu = sqrt(v3_dot(u, u));
     if (!(lu > 1e-9)) { /* opposite directions: no common point at infinity */
         *ok = 0;
         return 0.0;
     }
-    return -dot3(u, dab) / lu;
+    return -v3_dot(u, dab) / lu;
 }
 
 double rs_coherent_power(const lp_ray *r, size_t n, const rs_wavelets *t,
@@ -108,7 +107,7 @@ double rs_coherent_power(const lp_ray *r, size_t n, const rs_wavelets *t,
             if (gamma < 1e-12)
                 continue;
             double dphi = k0 * dop - RS_COH_PI * (a->kphi - b->kphi) + (a->phase - b->phase);
-            double vv = dot3(a->vp, b->vp);
+            double vv = v3_dot(a->vp, b->vp);
             total += 2.0 * gamma * sqrt(a->intensity * b->intensity) * vv * cos(dphi);
         }
     }

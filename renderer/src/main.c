@@ -2,7 +2,8 @@
  *
  * Exit status: 0 success; 1 the render or writing the output failed;
  * 2 bad input (command line, scene file, camera).  Every message is one
- * line on stderr starting "lensrender: ". */
+ * line on stderr starting "lensrender: ".  A thin driver over the
+ * renderer's face (lensrender/lensrender.h). */
 #define _POSIX_C_SOURCE 200809L
 
 #include <stdio.h>
@@ -12,19 +13,14 @@
 #include <unistd.h>
 
 #include "args.h"
-#include "auto_settings.h"
-#include "camera.h"
+#include "library_path.h"
+#include "lensrender/lensrender.h"
 #include "support/cli.h"
 #include "support/image.h"
-#include "integrator.h"
-#include "library_path.h"
-#include "parser.h"
-#include "scene.h"
 #include "support/tiles.h"
 
 #define EXIT_RENDER 1
 #define EXIT_BAD 2
-#define TILE_SIZE 16
 #define MSG_MAX 1024
 
 static const char *const usage_text[] = {
@@ -85,154 +81,115 @@ static const char *const usage_text[] = {
 "Exit status: 0 success, 1 render or output failure, 2 bad input.\n",
 };
 
-/* One line "lensrender: [PREFIX: ]MESSAGE" on stderr. */
-static void say(const char *prefix, const char *msg)
+/* One line "lensrender: MESSAGE" on stderr. */
+static void say(const char *msg)
 {
-    if (prefix)
-        sp_say("lensrender", "%s: %s", prefix, msg);
-    else
-        sp_say("lensrender", "%s", msg);
-}
-
-/* ---- the render: tiles of pixels into an rs_image ---------------------- */
-
-typedef struct render_ctx {
-    const rs_integrator *it;
-    rs_image *img;
-} render_ctx;
-
-static void *worker_make(void *user)
-{
-    const render_ctx *c = user;
-    return rs_worker_create(c->it);
-}
-
-static void worker_free(void *worker)
-{
-    rs_worker_destroy(worker);
-}
-
-static void render_tile(void *user, void *worker, int x0, int y0, int x1,
-                        int y1)
-{
-    const render_ctx *c = user;
-    for (int j = y0; j < y1; j++)
-        for (int i = x0; i < x1; i++) {
-            rs_color col;
-            float *px = c->img->rgb + 3 * ((size_t)j * (size_t)c->img->width +
-                                           (size_t)i);
-            rs_integrator_pixel(c->it, worker, i, j, &col);
-            px[0] = (float)col.r;
-            px[1] = (float)col.g;
-            px[2] = (float)col.b;
-        }
+    sp_say("lensrender", "%s", msg);
 }
 
 /* The reader's warnings and #debug text, on stderr. */
-static void print_messages(const rs_scene *s, int quiet)
+static void print_messages(const lr_scene *s, int quiet)
 {
     if (quiet)
         return;
-    for (size_t i = 0; i < s->n_messages; i++) {
-        if (s->messages[i].kind == RS_MSG_DEBUG)
-            fputs(s->messages[i].text, stderr);
+    for (size_t k = 0; k < lr_scene_message_count(s); k++) {
+        lr_message_kind kind;
+        const char *text = lr_scene_message(s, k, &kind);
+        if (kind == LR_MESSAGE_DEBUG)
+            fputs(text, stderr);
         else
-            fprintf(stderr, "lensrender: %s\n", s->messages[i].text);
+            fprintf(stderr, "lensrender: %s\n", text);
     }
+}
+
+static lr_mode face_mode(const rs_args *a)
+{
+    if (a->mode_auto)
+        return LR_MODE_AUTO;
+    switch (a->mode) {
+    case RS_MODE_FRESNEL: return LR_MODE_FRESNEL;
+    case RS_MODE_SCHLICK: return LR_MODE_SCHLICK;
+    case RS_MODE_RGB: return LR_MODE_RGB;
+    default: return LR_MODE_POLARIZED;
+    }
+}
+
+/* The terminal progress line (nothing when stderr is not a terminal). */
+static int show_progress(void *user, long long done, long long total)
+{
+    rs_progress_line_show(user, done, total, done >= total);
+    return 0;
+}
+
+/* Bad input exits 2, a failed render or output 1. */
+static int exit_status(lr_status st)
+{
+    return st == LR_ERROR_INVALID_ARGUMENT || st == LR_ERROR_IO || st == LR_ERROR_SCENE ||
+                   st == LR_ERROR_CAMERA
+               ? EXIT_BAD
+               : EXIT_RENDER;
 }
 
 /* Everything after the command line; returns the exit status. */
 static int run(const rs_args *a)
 {
     char msg[MSG_MAX] = "";
-    rs_scene scene;
-    rs_parse_opts popts;
-    const char *dirs[RS_ARGS_LIBRARY_MAX + 4];
-    rs_view view;
-    rs_render_opts ropts;
-    rs_integrator *it = NULL;
+    lr_error err;
+    lr_load_opts lo;
+    lr_render_opts ro, used;
+    lr_scene *scene = NULL;
+    lr_renderer *r = NULL;
     rs_image img;
-    render_ctx ctx;
-    rs_mode mode = a->mode;
-    int depth, status = 0;
+    rs_progress_line line;
+    int status = 0;
+    lr_status st;
     double t0 = sp_now_seconds();
 
     memset(&img, 0, sizeof img);
-    rs_scene_init(&scene);
-    rs_parse_opts_init(&popts);
-    popts.image_width = a->width;
-    popts.image_height = a->height;
-    popts.include_dirs = dirs;
-    popts.n_include_dirs = rs_library_path(a->library, (size_t)a->n_library, dirs,
-                                           sizeof dirs / sizeof dirs[0]);
-    if (rs_parse_file(a->scene, &popts, &scene, msg, sizeof msg) != 0) {
-        print_messages(&scene, a->quiet);
-        say(NULL, msg);
-        status = EXIT_BAD;
+    lr_load_opts_init(&lo);
+    lo.image_width = a->width;
+    lo.image_height = a->height;
+    lo.library_dirs = a->library;
+    lo.n_library_dirs = (size_t)a->n_library;
+    st = lr_scene_load(a->scene, &lo, &scene, &err);
+    print_messages(scene, a->quiet);
+    if (st != LR_OK) {
+        say(err.message);
+        status = exit_status(st);
         goto done;
     }
-    print_messages(&scene, a->quiet);
     if (a->aa_threshold >= 0.0 && !a->quiet)
         fprintf(stderr, "lensrender: +A%g: every pixel gets %d x %d regular samples (the "
                 "threshold is not used)\n", a->aa_threshold, a->aa, a->aa);
-    if (rs_scene_prepare(&scene, msg, sizeof msg) != 0) {
-        say(NULL, msg);
-        status = EXIT_BAD;
+    lr_render_opts_init(&ro);
+    ro.mode = face_mode(a);
+    ro.tolerance = a->tolerance;
+    ro.width = a->width;
+    ro.height = a->height;
+    ro.depth = a->depth;
+    ro.wavelengths = a->mode_auto && !a->wavelengths_given ? 0 : a->wavelengths;
+    ro.cutoff = a->cutoff;
+    ro.aa = a->aa;
+    ro.no_dispersion = a->no_dispersion;
+    ro.threads = a->threads;
+    if ((st = lr_renderer_create(scene, &ro, &r, &err)) != LR_OK) {
+        say(err.message);
+        status = exit_status(st);
         goto done;
     }
-    if (a->no_dispersion &&
-        rs_scene_freeze_glass(&scene, RS_LAMBDA_D_LINE, msg, sizeof msg) != 0) {
-        say(NULL, msg);
-        status = EXIT_BAD;
-        goto done;
-    }
-    if (rs_camera_setup(&scene.camera, a->width, a->height, &view, msg,
-                        sizeof msg) != 0) {
-        say(a->scene, msg);
-        status = EXIT_BAD;
-        goto done;
-    }
-    rs_render_opts_init(&ropts);
-    ropts.mode = mode;
-    ropts.depth = a->depth;
-    ropts.wavelengths = a->wavelengths;
-    ropts.cutoff = a->cutoff;
-    ropts.width = a->width;
-    ropts.height = a->height;
-    ropts.aa = a->aa;
-    if (a->mode_auto) {
-        char why[512];
-        rs_auto_request req = {a->tolerance > 0.0 ? a->tolerance : RS_AUTO_TOLERANCE_DEFAULT,
-                               a->width, a->height, a->depth,
-                               a->wavelengths_given ? a->wavelengths : 0, a->cutoff};
-        if (rs_auto_choose(&scene, &req, &ropts, why, sizeof why, msg, sizeof msg) != 0) {
-            say(a->scene, msg);
-            status = EXIT_RENDER;
-            goto done;
-        }
-        mode = ropts.mode;
-        if (!a->quiet)
-            fprintf(stderr, "lensrender: auto: %s\n", why);
-    }
-    ropts.aa = a->aa; /* antialiasing is the user's, whatever auto chose */
-    depth = ropts.depth > 0 ? ropts.depth : scene.settings.max_trace_level;
-    if (rs_integrator_create(&scene, &ropts, &it, msg, sizeof msg) != 0) {
-        say(a->scene, msg);
-        status = EXIT_RENDER;
-        goto done;
-    }
+    if (a->mode_auto && !a->quiet)
+        fprintf(stderr, "lensrender: auto: %s\n", lr_renderer_explanation(r));
+    lr_renderer_settings(r, &used);
 
     if (rs_image_create(&img, a->width, a->height) != 0) {
-        say(NULL, "out of memory for the image");
+        say("out of memory for the image");
         status = EXIT_RENDER;
         goto done;
     }
-    ctx.it = it;
-    ctx.img = &img;
-    if (rs_render_tiles(a->width, a->height, TILE_SIZE, a->threads,
-                        worker_make, worker_free, render_tile, &ctx,
-                        a->quiet ? -1 : STDERR_FILENO) != 0) {
-        say(NULL, "the render failed (out of memory for a worker thread)");
+    rs_progress_line_start(&line, a->quiet ? -1 : STDERR_FILENO);
+    if ((st = lr_render_image(r, img.rgb, line.fd >= 0 ? show_progress : NULL, &line,
+                              &err)) != LR_OK) {
+        say(err.message);
         status = EXIT_RENDER;
         goto done;
     }
@@ -241,7 +198,7 @@ static int run(const rs_args *a)
      * is left as it was.  Each file is written atomically. */
     if (a->pfm) {
         if (rs_pfm_write(a->pfm, &img, msg, sizeof msg) != 0) {
-            say(NULL, msg);
+            say(msg);
             status = EXIT_RENDER;
             goto done;
         }
@@ -249,7 +206,7 @@ static int run(const rs_args *a)
             fprintf(stderr, "lensrender: wrote %s\n", a->pfm);
     }
     if (rs_png_write(a->out_png, &img, msg, sizeof msg) != 0) {
-        say(NULL, msg);
+        say(msg);
         status = EXIT_RENDER;
         goto done;
     }
@@ -257,13 +214,13 @@ static int run(const rs_args *a)
         fprintf(stderr,
                 "lensrender: wrote %s (%d x %d, %s, %d wavelengths, depth %d) "
                 "in %.2f s\n",
-                a->out_png, a->width, a->height, rs_mode_name(mode),
-                ropts.wavelengths, depth, sp_now_seconds() - t0);
+                a->out_png, a->width, a->height, lr_mode_name(used.mode),
+                used.wavelengths, used.depth, sp_now_seconds() - t0);
 
 done:
     rs_image_free(&img);
-    rs_integrator_destroy(it);
-    rs_scene_free(&scene);
+    lr_renderer_free(r);
+    lr_scene_free(scene);
     return status;
 }
 
@@ -272,26 +229,20 @@ int main(int argc, char **argv)
     rs_args *a = malloc(sizeof *a);
     int status;
     if (!a) {
-        say(NULL, "out of memory");
+        say("out of memory");
         return EXIT_RENDER;
     }
     rs_args_init(a);
     if (rs_args_parse(a, argc, argv)) {
-        say(NULL, a->error);
+        say(a->error);
         free(a);
         return EXIT_BAD;
     }
-    if (a->help) {
-        for (size_t i = 0; i < sizeof usage_text / sizeof *usage_text; i++)
-            fputs(usage_text[i], stdout);
+    if (a->help || a->version) {
+        int rc = a->help ? sp_print_text(usage_text, sizeof usage_text / sizeof *usage_text)
+                         : sp_print_version("lensrender", lp_version_string());
         free(a);
-        return fflush(stdout) == 0 ? 0 : EXIT_RENDER;
-    }
-    if (a->version) {
-        printf("lensrender (lensprim) %d.%d.%d\n", LP_VERSION_MAJOR,
-               LP_VERSION_MINOR, LP_VERSION_PATCH);
-        free(a);
-        return fflush(stdout) == 0 ? 0 : EXIT_RENDER;
+        return rc == 0 ? 0 : EXIT_RENDER;
     }
     status = run(a);
     free(a);

@@ -1202,23 +1202,11 @@ static int transform_kind(const rs_token *t)
     return XF_NONE;
 }
 
-static int xf_finite(const rs_transform *xf)
-{
-    for (int i = 0; i < 3; i++) {
-        if (!isfinite(xf->t[i]) || !isfinite(xf->inv_t[i]))
-            return 0;
-        for (int j = 0; j < 3; j++)
-            if (!isfinite(xf->m[i][j]) || !isfinite(xf->inv_m[i][j]))
-                return 0;
-    }
-    return 1;
-}
-
 /* *xf = step after *xf, refused when the result is not finite. */
 static int apply_step(parser *p, const rs_token *kw, rs_transform *xf, const rs_transform *step)
 {
     rs_transform_compose(xf, step, xf);
-    if (!xf_finite(xf))
+    if (!rs_transform_finite(xf))
         return error_at(p, kw->line, kw->column,
                         "the transforms are too large: a value is not finite");
     return 0;
@@ -2196,7 +2184,7 @@ static int transform_object(parser *p, const rs_token *kw, rs_object *o, const r
         inv.inv_t[i] = T->t[i];
     }
     rs_transform_compose(&inv, &o->pigment.to_pattern, &o->pigment.to_pattern);
-    if (!xf_finite(&o->pigment.to_pattern))
+    if (!rs_transform_finite(&o->pigment.to_pattern))
         return error_at(p, kw->line, kw->column,
                         "the transforms are too large: a value is not finite");
     if (o->type == RS_OBJ_LENS || o->type == RS_OBJ_POLARIZER) {

@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "scene.h"
+#include "support/vec.h"
 
 static void mat_identity(double m[3][3])
 {
@@ -118,15 +119,22 @@ void rs_transform_compose(const rs_transform *a, const rs_transform *b, rs_trans
     *out = r; /* a, b and out may alias */
 }
 
-static int finite3(lp_vec3 v)
+int rs_transform_finite(const rs_transform *xf)
 {
-    return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
+    for (int i = 0; i < 3; i++) {
+        if (!isfinite(xf->t[i]) || !isfinite(xf->inv_t[i]))
+            return 0;
+        for (int j = 0; j < 3; j++)
+            if (!isfinite(xf->m[i][j]) || !isfinite(xf->inv_m[i][j]))
+                return 0;
+    }
+    return 1;
 }
 
 int rs_transform_translate(rs_transform *xf, lp_vec3 v)
 {
     rs_transform s;
-    if (!finite3(v))
+    if (!v3_finite(v))
         return 0;
     rs_transform_identity(&s);
     s.t[0] = v.x;
@@ -167,7 +175,7 @@ int rs_transform_rotate(rs_transform *xf, lp_vec3 degrees)
     double rx[3][3], ry[3][3], rz[3][3], tmp[3][3];
     rs_transform s;
 
-    if (!finite3(degrees))
+    if (!v3_finite(degrees))
         return 0;
     sincos_deg(degrees.x, &sx, &cx);
     sincos_deg(degrees.y, &sy, &cy);
@@ -197,7 +205,7 @@ int rs_transform_rotate(rs_transform *xf, lp_vec3 degrees)
 int rs_transform_scale(rs_transform *xf, lp_vec3 v)
 {
     rs_transform s;
-    if (!finite3(v) || v.x == 0.0 || v.y == 0.0 || v.z == 0.0)
+    if (!v3_finite(v) || v.x == 0.0 || v.y == 0.0 || v.z == 0.0)
         return 0;
     rs_transform_identity(&s);
     s.m[0][0] = v.x;

@@ -31,6 +31,28 @@ void sp_say(const char *program, const char *fmt, ...)
     fprintf(stderr, "%s\n", line);
 }
 
+const char *sp_format(char *buf, size_t size, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(buf, size, fmt, ap);
+    va_end(ap);
+    return buf;
+}
+
+int sp_print_text(const char *const *parts, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        fputs(parts[i], stdout);
+    return fflush(stdout) == 0 && !ferror(stdout) ? 0 : -1;
+}
+
+int sp_print_version(const char *program, const char *version)
+{
+    printf("%s (lensprim) %s\n", program, version);
+    return fflush(stdout) == 0 && !ferror(stdout) ? 0 : -1;
+}
+
 double sp_now_seconds(void)
 {
     struct timespec t;

@@ -27,6 +27,10 @@ typedef struct rs_pool {
     atomic_int next_tile;      /* the next tile number to hand out */
     atomic_llong pixels_done;  /* for progress */
     atomic_int failed;         /* a worker could not be created */
+    atomic_int cancelled;      /* the progress callback said stop */
+    rs_progress_fn progress;   /* called by the calling thread only */
+    void *progress_user;
+    int inline_progress;       /* no thread: run_tiles reports per tile */
 
     pthread_mutex_t lock;      /* guards running */
     pthread_cond_t ended;      /* signalled when a thread ends */
@@ -56,7 +60,8 @@ static void run_tiles(rs_pool *p)
     }
     for (;;) {
         int t, tx, ty, x0, y0, x1, y1;
-        if (atomic_load_explicit(&p->failed, memory_order_relaxed))
+        if (atomic_load_explicit(&p->failed, memory_order_relaxed) ||
+            atomic_load_explicit(&p->cancelled, memory_order_relaxed))
             break;
         t = atomic_fetch_add(&p->next_tile, 1);
         if (t >= p->n_tiles)
@@ -71,6 +76,10 @@ static void run_tiles(rs_pool *p)
         atomic_fetch_add_explicit(&p->pixels_done,
                                   (long long)(x1 - x0) * (y1 - y0),
                                   memory_order_relaxed);
+        if (p->inline_progress && p->progress &&
+            p->progress(p->progress_user, atomic_load(&p->pixels_done),
+                        (long long)p->width * p->height) != 0)
+            atomic_store(&p->cancelled, 1);
     }
     if (worker && p->worker_destroy)
         p->worker_destroy(worker);
@@ -89,11 +98,6 @@ static void *thread_main(void *arg)
 
 /* ---- progress line ---------------------------------------------------- */
 
-typedef struct rs_progress {
-    int fd;                 /* -1: no progress output */
-    struct timespec start;
-    size_t last_len;        /* length of the previous line, to blank it */
-} rs_progress;
 
 static double seconds_since(const struct timespec *t0)
 {
@@ -117,7 +121,7 @@ static void write_all(int fd, const char *s, size_t n)
     }
 }
 
-static void progress_show(rs_progress *pr, long long done, long long total,
+void rs_progress_line_show(rs_progress_line *pr, long long done, long long total,
                           int final)
 {
     char line[160];
@@ -159,13 +163,43 @@ static void progress_show(rs_progress *pr, long long done, long long total,
 
 /* ---- the pool --------------------------------------------------------- */
 
+void rs_progress_line_start(rs_progress_line *pr, int fd)
+{
+    pr->fd = (fd >= 0 && isatty(fd)) ? fd : -1;
+    pr->last_len = 0;
+    clock_gettime(CLOCK_MONOTONIC, &pr->start);
+}
+
+/* The callback rs_render_tiles gives rs_render_tiles_cb: the line. */
+static int line_progress(void *user, long long done, long long total)
+{
+    rs_progress_line *pr = user;
+    rs_progress_line_show(pr, done, total, done >= total);
+    return 0;
+}
+
 int rs_render_tiles(int width, int height, int tile_size, int threads,
                     void *(*worker_create)(void *user),
                     void (*worker_destroy)(void *worker), rs_tile_fn fn,
                     void *user, int progress_fd)
 {
+    rs_progress_line pr;
+    int rc;
+    rs_progress_line_start(&pr, progress_fd);
+    rc = rs_render_tiles_cb(width, height, tile_size, threads, worker_create,
+                            worker_destroy, fn, user,
+                            pr.fd >= 0 ? line_progress : NULL, &pr);
+    if (rc != 0 && pr.last_len > 0)
+        write_all(pr.fd, "\n", 1); /* end the line the render left open */
+    return rc == -2 ? -1 : rc;
+}
+
+int rs_render_tiles_cb(int width, int height, int tile_size, int threads,
+                       void *(*worker_create)(void *user),
+                       void (*worker_destroy)(void *worker), rs_tile_fn fn,
+                       void *user, rs_progress_fn progress, void *progress_user)
+{
     rs_pool p;
-    rs_progress pr;
     pthread_t *ids;
     pthread_condattr_t cattr;
     int tiles_y, started = 0;
@@ -190,6 +224,9 @@ int rs_render_tiles(int width, int height, int tile_size, int threads,
     atomic_init(&p.next_tile, 0);
     atomic_init(&p.pixels_done, 0);
     atomic_init(&p.failed, 0);
+    atomic_init(&p.cancelled, 0);
+    p.progress = progress;
+    p.progress_user = progress_user;
     total = (long long)width * height;
 
     if (threads <= 0)
@@ -199,9 +236,6 @@ int rs_render_tiles(int width, int height, int tile_size, int threads,
     if (threads > p.n_tiles)
         threads = p.n_tiles;
 
-    pr.fd = (progress_fd >= 0 && isatty(progress_fd)) ? progress_fd : -1;
-    pr.last_len = 0;
-    clock_gettime(CLOCK_MONOTONIC, &pr.start);
 
     if (pthread_mutex_init(&p.lock, NULL) != 0)
         return -1;
@@ -233,9 +267,11 @@ int rs_render_tiles(int width, int height, int tile_size, int threads,
 
     if (started == 0) {
         /* No thread at all: do the work here. */
+        p.inline_progress = 1;
         run_tiles(&p);
     } else {
-        progress_show(&pr, 0, total, 0);
+        if (progress && progress(progress_user, 0, total) != 0)
+            atomic_store(&p.cancelled, 1);
         pthread_mutex_lock(&p.lock);
         while (p.running > 0) {
             struct timespec until;
@@ -250,7 +286,9 @@ int rs_render_tiles(int width, int height, int tile_size, int threads,
                 ;
             if (p.running > 0) {
                 pthread_mutex_unlock(&p.lock);
-                progress_show(&pr, atomic_load(&p.pixels_done), total, 0);
+                if (progress && !atomic_load(&p.cancelled) &&
+                    progress(progress_user, atomic_load(&p.pixels_done), total) != 0)
+                    atomic_store(&p.cancelled, 1);
                 pthread_mutex_lock(&p.lock);
             }
         }
@@ -259,9 +297,13 @@ int rs_render_tiles(int width, int height, int tile_size, int threads,
             pthread_join(ids[k], NULL);
     }
     free(ids);
-    progress_show(&pr, atomic_load(&p.pixels_done), total, 1);
+    if (progress && !p.inline_progress && !atomic_load(&p.cancelled) &&
+        !atomic_load(&p.failed))
+        (void)progress(progress_user, atomic_load(&p.pixels_done), total);
 
     pthread_cond_destroy(&p.ended);
     pthread_mutex_destroy(&p.lock);
-    return atomic_load(&p.failed) ? -1 : 0;
+    if (atomic_load(&p.failed))
+        return -1;
+    return atomic_load(&p.cancelled) ? -2 : 0;
 }

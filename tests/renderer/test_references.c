@@ -1,7 +1,7 @@
 /* test_references.c -- regression against stored renders.
  *
  * Every .scene file in scenes/ and in tests/renderer/scenes/ (scenes made
- * for this test: a lit one with shadows) is rendered through the core API
+ * for this test: a lit one with shadows) is rendered through the renderer's face
  * in each light model (polarized at 80 x 60; fresnel, schlick and rgb at
  * 40 x 30, a quarter of the time) with
  * the default settings (16 wavelengths, the scene's max_trace_level and
@@ -37,12 +37,8 @@
 #include <time.h>
 
 #include "check.h"
+#include "lensrender/lensrender.h"
 #include "support/image.h"
-#include "integrator.h"
-#include "library_path.h"
-#include "parser.h"
-#include "scene.h"
-#include "support/tiles.h"
 
 #ifndef LP_SOURCE_DIR
 #error "LP_SOURCE_DIR must name the source tree"
@@ -61,11 +57,11 @@ static const char *const SCENE_DIRS[2] = {LP_SOURCE_DIR "/scenes",
 static const char *const REF_DIR = LP_SOURCE_DIR "/tests/renderer/ref";
 
 /* The unpolarized models at half the size: a quarter of the time. */
-static const struct { rs_mode mode; const char *name; int w, h; } MODES[4] = {
-    {RS_MODE_POLARIZED, "polarized", REF_W, REF_H},
-    {RS_MODE_FRESNEL, "fresnel", REF_W / 2, REF_H / 2},
-    {RS_MODE_SCHLICK, "schlick", REF_W / 2, REF_H / 2},
-    {RS_MODE_RGB, "rgb", REF_W / 2, REF_H / 2},
+static const struct { lr_mode mode; const char *name; int w, h; } MODES[4] = {
+    {LR_MODE_POLARIZED, "polarized", REF_W, REF_H},
+    {LR_MODE_FRESNEL, "fresnel", REF_W / 2, REF_H / 2},
+    {LR_MODE_SCHLICK, "schlick", REF_W / 2, REF_H / 2},
+    {LR_MODE_RGB, "rgb", REF_W / 2, REF_H / 2},
 };
 #define N_MODES 4
 
@@ -104,81 +100,48 @@ static int list_names(const char *dir, const char *ext, char **names, int max)
 
 /* ---- rendering ----------------------------------------------------------------- */
 
-typedef struct job {
-    const rs_integrator *it;
-    rs_image *img;
-} job;
-
-static void *job_worker_make(void *user)
-{
-    return rs_worker_create(((const job *)user)->it);
-}
-
-static void job_worker_free(void *w)
-{
-    rs_worker_destroy(w);
-}
-
-static void job_tile(void *user, void *worker, int x0, int y0, int x1, int y1)
-{
-    const job *jb = user;
-    for (int j = y0; j < y1; j++)
-        for (int i = x0; i < x1; i++) {
-            rs_color c;
-            float *px = jb->img->rgb + 3 * ((size_t)j * (size_t)jb->img->width + (size_t)i);
-            rs_integrator_pixel(jb->it, worker, i, j, &c);
-            px[0] = (float)c.r;
-            px[1] = (float)c.g;
-            px[2] = (float)c.b;
-        }
-}
-
-/* Render <dir>/<name>.scene in MODES[m] as the references are made.  0 or -1. */
+/* Render <dir>/<name>.scene in MODES[m] as the references are made,
+ * through the renderer's face (as every program renders).  0 or -1. */
 static int render_scene(const char *dir, const char *name, int m, rs_image *img)
 {
-    const rs_mode mode = MODES[m].mode;
     const int W = MODES[m].w, H = MODES[m].h;
-    char path[4096], msg[1024] = "";
-    rs_scene sc;
-    rs_parse_opts po;
-    const char *dirs[4];
-    rs_render_opts ro;
-    rs_integrator *it = NULL;
+    char path[4096];
+    lr_scene *sc = NULL;
+    lr_renderer *r = NULL;
+    lr_load_opts lo;
+    lr_render_opts ro;
+    lr_error err;
     int rc = -1;
 
     snprintf(path, sizeof path, "%s/%s.scene", dir, name);
     memset(img, 0, sizeof *img);
-    rs_scene_init(&sc);
-    rs_parse_opts_init(&po);
-    po.image_width = W;
-    po.image_height = H;
-    po.include_dirs = dirs;
-    po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof dirs[0]);
-    rs_render_opts_init(&ro);
-    ro.mode = mode;
+    lr_load_opts_init(&lo);
+    lo.image_width = W;
+    lo.image_height = H;
+    lr_render_opts_init(&ro);
+    ro.mode = MODES[m].mode;
     ro.width = W;
     ro.height = H;
-    if (rs_parse_file(path, &po, &sc, msg, sizeof msg) != 0 ||
-        rs_scene_prepare(&sc, msg, sizeof msg) != 0 ||
-        rs_integrator_create(&sc, &ro, &it, msg, sizeof msg) != 0 ||
-        rs_image_create(img, W, H) != 0) {
-        if (!msg[0])
-            snprintf(msg, sizeof msg, "out of memory for the image");
-        fprintf(stderr, "%s: %s\n", name, msg);
+    ro.threads = 2;
+    if (lr_scene_load(path, &lo, &sc, &err) != LR_OK ||
+        lr_renderer_create(sc, &ro, &r, &err) != LR_OK) {
+        fprintf(stderr, "%s: %s\n", name, err.message);
         goto done;
     }
-    job jb = {it, img};
-    if (rs_render_tiles(W, H, 16, 2, job_worker_make, job_worker_free, job_tile, &jb,
-                        -1) != 0) {
-        fprintf(stderr, "%s: the render failed\n", name);
+    if (rs_image_create(img, W, H) != 0) {
+        fprintf(stderr, "%s: out of memory for the image\n", name);
+        goto done;
+    }
+    if (lr_render_image(r, img->rgb, NULL, NULL, &err) != LR_OK) {
+        fprintf(stderr, "%s: %s\n", name, err.message);
         goto done;
     }
     rc = 0;
 done:
     if (rc != 0)
         rs_image_free(img);
-    rs_integrator_destroy(it);
-    rs_scene_free(&sc);
+    lr_renderer_free(r);
+    lr_scene_free(sc);
     return rc;
 }
 

@@ -16,6 +16,23 @@ void sp_say(const char *program, const char *fmt, ...)
 #endif
     ;
 
+/* Format a one-line message into buf (printf's rules, cut to size - 1
+ * characters) and return buf: what an argument parser hands back as its
+ * error.  size must be >= 1. */
+const char *sp_format(char *buf, size_t size, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/* --help: the n parts of the text on stdout, in order, flushed.  0, or -1
+ * when stdout could not be written. */
+int sp_print_text(const char *const *parts, size_t n);
+
+/* --version: "PROGRAM (lensprim) VERSION" and a newline on stdout,
+ * flushed.  0, or -1 when stdout could not be written. */
+int sp_print_version(const char *program, const char *version);
+
 /* Seconds on the monotonic clock (for elapsed times only). */
 double sp_now_seconds(void);
 

@@ -1,11 +1,15 @@
-/* scene.h -- the scene a .scene file describes (renderer-internal).
+/* scene.h -- the scene a .scene file describes: what lr_scene_description
+ * (lensrender/lensrender.h) shows of a loaded scene, and what the
+ * renderer itself renders from.
  *
- * The parser fills an rs_scene; the renderer reads it.  POV-Ray meaning
- * throughout: left-handed coordinates (x right, y up, z into the screen),
- * lengths in millimetres for lenses, colours linear RGB.  Transforms are
- * affine maps from object space to world space, composed in the order the
- * keywords appear (POV-Ray: each new transform applies after the ones
- * before it). */
+ * The reader fills an rs_scene and checks it (every rule once, with the
+ * place it was written); the renderer reads it.  A program using the face
+ * only reads a description: the functions at the end that build, prepare
+ * or change one are the renderer's own.  POV-Ray meaning throughout:
+ * left-handed coordinates (x right, y up, z into the screen), lengths in
+ * millimetres for lenses, colours linear RGB.  Transforms are affine maps
+ * from object space to world space, composed in the order the keywords
+ * appear (POV-Ray: each new transform applies after the ones before it). */
 #ifndef RS_SCENE_H
 #define RS_SCENE_H
 
@@ -235,6 +239,8 @@ void rs_transform_compose(const rs_transform *a, const rs_transform *b, rs_trans
 int rs_transform_translate(rs_transform *xf, lp_vec3 v);
 int rs_transform_rotate(rs_transform *xf, lp_vec3 degrees);
 int rs_transform_scale(rs_transform *xf, lp_vec3 s);
+/* Nonzero when every number of the transform and of its inverse is finite. */
+int rs_transform_finite(const rs_transform *xf);
 
 void rs_scene_init(rs_scene *scene);
 /* Free everything the scene owns (lenses, catalog, arrays). */
@@ -244,6 +250,19 @@ void rs_scene_free(rs_scene *scene);
  * afterwards (call it again if they do).
  * Returns 0, or -1 with a message "file:line:col: ..." in msg. */
 int rs_scene_prepare(rs_scene *scene, char *msg, size_t msg_size);
+
+/* The rules every scene obeys, stated once: every number finite; plane,
+ * disc, polarizer normals, a polarizer's axis, a lens's axis and a
+ * polarized light's field unit vectors (to 1e-9); sphere, disc, cylinder,
+ * torus, polarizer radii > 0, cone radii >= 0, 0 <= a disc's hole <
+ * its radius; phong_size, roughness and ior > 0; a light's coherence
+ * length >= 0; every object placed in a file (line, column >= 1); a lens
+ * not yet created one that lp_lens_create accepts; a CSG object has
+ * members, each keeping the same rules.  The reader builds only
+ * scenes that obey them (it refuses each broken rule where it is written);
+ * who builds or changes a scene otherwise calls this.  Returns 0, or -1
+ * with "FILE:LINE:COL: what" (or "camera: ..." and the like) in msg. */
+int rs_scene_check(const rs_scene *scene, char *msg, size_t msg_size);
 
 /* The helium d line (air wavelength), where catalogs quote n_d. */
 #define RS_LAMBDA_D_LINE 587.5618
