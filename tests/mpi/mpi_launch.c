@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "mpi_launch.h"
+#include "test_files.h"
 
 void ml_environment(void)
 {
@@ -51,4 +52,14 @@ int ml_count_lines(const char *text, const char *prefix)
         line = end ? end + 1 : NULL;
     }
     return count;
+}
+
+int ml_same_file(const char *a, const char *b)
+{
+    size_t na, nb;
+    char *x = tf_read(a, &na), *y = tf_read(b, &nb);
+    int same = x && y && na == nb && memcmp(x, y, na) == 0;
+    free(x);
+    free(y);
+    return same;
 }

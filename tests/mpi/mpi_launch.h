@@ -31,6 +31,9 @@ int ml_run(int n, int seconds, const char *program, const char *const args[], tp
  * of the MPI build run without the launcher (a run of one process). */
 void ml_environment(void);
 
+/* Whether the files at a and b hold the same bytes (both readable). */
+int ml_same_file(const char *a, const char *b);
+
 /* The number of lines of text that start with prefix. */
 int ml_count_lines(const char *text, const char *prefix);
 
