@@ -3,7 +3,6 @@
  * rs_args.error. */
 #include "args.h"
 
-#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -42,40 +41,11 @@ const char *rs_mode_name(rs_mode mode)
     return "unknown";
 }
 
-static int is_space(char c)
-{
-    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' ||
-           c == '\f';
-}
-
-/* A whole string as an integer in [lo, hi].  1: ok; 0: not an integer;
- * -1: out of range. */
-static int parse_int(const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    long v;
-    if (*s == '\0' || is_space(*s))
-        return 0;
-    errno = 0;
-    v = strtol(s, &end, 10);
-    if (end == s || *end != '\0')
-        return 0;
-    if (errno == ERANGE || v < lo || v > hi)
-        return -1;
-    *out = v;
-    return 1;
-}
-
 /* A whole string as a finite double.  1: ok; 0: not a finite number. */
 static int parse_double(const char *s, double *out)
 {
-    char *end;
     double v;
-    if (*s == '\0' || is_space(*s))
-        return 0;
-    errno = 0;
-    v = strtod(s, &end);
-    if (end == s || *end != '\0' || !isfinite(v))
+    if (sp_parse_double(s, &v) != 1 || !isfinite(v))
         return 0;
     *out = v;
     return 1;
@@ -85,7 +55,7 @@ static const char *int_option(rs_args *args, const char *name, const char *val,
                               long lo, long hi, int *out)
 {
     long v;
-    int r = parse_int(val, lo, hi, &v);
+    int r = sp_parse_long(val, lo, hi, &v);
     if (r == 0)
         return fail(args, "%s: '%s' is not a whole number", name, val);
     if (r < 0)

@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "bvh.h"
 #include "check.h"
 #include "csg.h"
 #include "one_pixel.h"
@@ -408,6 +409,56 @@ static void test_shadow_render(void)
     }
 }
 
+/* A scene of 12 CSG objects is served by the bounding volume hierarchy:
+ * its nearest hits must be those of a loop over every object, and the
+ * boxes it uses must be finite (no object left unbounded). */
+static void test_bvh(void)
+{
+    char text[8192];
+    size_t n = 0;
+    rs_scene s;
+    char msg[512];
+    for (int k = 0; k < 12; k++)
+        n += (size_t)snprintf(text + n, sizeof text - n,
+                              "%s { box { -1, 1 } sphere { <0.3,0.4,0>, %s } %s translate <%d, %d, %d> }\n",
+                              k % 2 ? "difference" : "intersection", k % 3 ? "1.2" : "0.6",
+                              k % 4 == 1 ? "rotate y*30" : "", 3 * (k % 4) - 4, 3 * (k / 4) - 3,
+                              k % 3);
+    rs_scene_init(&s);
+    if (rs_parse_string(text, "t.scene", NULL, &s, msg, sizeof msg) != 0 ||
+        rs_scene_prepare(&s, msg, sizeof msg) != 0) {
+        CHECK(0, "12 CSG objects: %s", msg);
+        rs_scene_free(&s);
+        return;
+    }
+    CHECK(rs_bvh_serves(s.bvh, &s) && rs_bvh_unbounded_count(s.bvh) == 0,
+          "the tree serves the scene with every CSG object bounded (%zu unbounded)",
+          rs_bvh_unbounded_count(s.bvh));
+    unsigned long long seed = 777;
+    int wrong = 0;
+    for (int k = 0; k < 3000; k++) {
+        double u[4];
+        for (int i = 0; i < 4; i++) {
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            u[i] = (double)(seed >> 11) / 9007199254740992.0;
+        }
+        lp_vec3 o = v3(12 * u[0] - 6, 10 * u[1] - 5, -20);
+        lp_vec3 d = unit(v3(0.3 * (u[2] - 0.5), 0.3 * (u[3] - 0.5), 1));
+        rs_hit h, best;
+        int got = rs_scene_intersect(&s, o, d, 0.0, INFINITY, -1, &h), want = 0;
+        double tmax = INFINITY;
+        for (size_t i = 0; i < s.n_objects; i++)
+            if (rs_object_intersect(&s.objects[i], o, d, 0.0, tmax, &best)) {
+                tmax = best.t;
+                want = 1;
+            }
+        if (got != want || (got && h.t != tmax))
+            wrong++;
+    }
+    CHECK(wrong == 0, "%d of 3000 rays: the tree's nearest hit differs from the loop's", wrong);
+    rs_scene_free(&s);
+}
+
 int main(void)
 {
     test_drilled();
@@ -416,5 +467,6 @@ int main(void)
     test_torus_grazing();
     test_bounds();
     test_shadow_render();
+    test_bvh();
     return check_finish("test_csg");
 }
