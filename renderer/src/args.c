@@ -329,3 +329,46 @@ const char *rs_args_parse(rs_args *args, int argc, char **argv)
         return args->error;
     return NULL;
 }
+
+/* The face's mode for the command line's. */
+static lr_mode face_mode(const rs_args *a)
+{
+    if (a->mode_auto)
+        return LR_MODE_AUTO;
+    switch (a->mode) {
+    case RS_MODE_FRESNEL: return LR_MODE_FRESNEL;
+    case RS_MODE_SCHLICK: return LR_MODE_SCHLICK;
+    case RS_MODE_RGB: return LR_MODE_RGB;
+    default: return LR_MODE_POLARIZED;
+    }
+}
+
+void rs_args_face_opts(const rs_args *a, lr_load_opts *lo, lr_render_opts *ro)
+{
+    lr_load_opts_init(lo);
+    lo->image_width = a->width;
+    lo->image_height = a->height;
+    lo->library_dirs = a->library;
+    lo->n_library_dirs = (size_t)a->n_library;
+    lr_render_opts_init(ro);
+    ro->mode = face_mode(a);
+    ro->tolerance = a->tolerance;
+    ro->width = a->width;
+    ro->height = a->height;
+    ro->depth = a->depth;
+    ro->wavelengths = a->mode_auto && !a->wavelengths_given ? 0 : a->wavelengths;
+    ro->cutoff = a->cutoff;
+    ro->aa = a->aa;
+    ro->no_dispersion = a->no_dispersion;
+    ro->threads = a->threads;
+}
+
+int rs_args_exit_status(lr_status st)
+{
+    if (st == LR_OK)
+        return 0;
+    return st == LR_ERROR_INVALID_ARGUMENT || st == LR_ERROR_IO || st == LR_ERROR_SCENE ||
+                   st == LR_ERROR_CAMERA
+               ? 2 /* bad input */
+               : 1 /* a render or output failure */;
+}
