@@ -54,29 +54,11 @@ static int copy_trimmed(const char *b, const char *e, char *buf, size_t n)
     return 1;
 }
 
-/* A whole string as a double.  1: ok (may be +-inf or NaN, the caller
- * decides); 0: not a number; -1: overflow (a finite literal too large). */
-static int parse_double(const char *s, double *out)
-{
-    char *end;
-    double v;
-    if (*s == '\0' || is_space(*s))
-        return 0;
-    errno = 0;
-    v = strtod(s, &end);
-    if (end == s || *end != '\0')
-        return 0;
-    if (errno == ERANGE && isinf(v))
-        return -1;
-    *out = v;
-    return 1;
-}
-
 /* A whole string as a finite double; messages name `what`. */
 static const char *parse_finite(lt_args *args, const char *ctx,
                                 const char *what, const char *s, double *out)
 {
-    int r = parse_double(s, out);
+    int r = sp_parse_double(s, out);
     if (r == 0)
         return fail(args, "%s: %s: '%s' is not a number", ctx, what, s);
     if (r < 0)
@@ -101,7 +83,7 @@ static const char *parse_positive(lt_args *args, const char *ctx,
 static const char *parse_radius(lt_args *args, const char *what,
                                 const char *s, double *out)
 {
-    int r = parse_double(s, out);
+    int r = sp_parse_double(s, out);
     if (r == 0)
         return fail(args, "--lens: %s: '%s' is not a number (use a radius "
                           "in mm, or inf or 0 for flat)", what, s);
@@ -134,7 +116,7 @@ static const char *parse_vec3(lt_args *args, const char *what, const char *s,
         if (!copy_trimmed(p, q, buf, sizeof buf))
             return fail(args, "%s: component %d is too long", what,
                         k + 1);
-        r = parse_double(buf, &v[k]);
+        r = sp_parse_double(buf, &v[k]);
         if (r == 0)
             return fail(args, "%s: component %d '%s' is not a number",
                         what, k + 1, buf);
@@ -544,12 +526,8 @@ static const struct {
 
 static const char *parse_depth(lt_args *args, const char *s)
 {
-    char *end;
     long v;
-    errno = 0;
-    v = strtol(s, &end, 10);
-    if (*s == '\0' || is_space(*s) || *end != '\0' || errno == ERANGE ||
-        v < 1 || v > LP_MAX_DEPTH)
+    if (sp_parse_long(s, 1, LP_MAX_DEPTH, &v) != 1)
         return fail(args, "--depth must be an integer from 1 to %d, got '%s'",
                     LP_MAX_DEPTH, s);
     args->depth = (int)v;
@@ -671,7 +649,7 @@ const char *lt_args_parse(lt_args *args, int argc, char **argv)
                 return args->error;
             break;
         case OPT_MEDIUM:
-            if (parse_double(value, &args->medium) != 1 ||
+            if (sp_parse_double(value, &args->medium) != 1 ||
                 !isfinite(args->medium) || !(args->medium > 0.0))
                 return fail(args, "--medium must be a finite index > 0, got "
                                   "'%s'", value);
@@ -685,12 +663,8 @@ const char *lt_args_parse(lt_args *args, int argc, char **argv)
             args->cone = 1;
             break;
         case OPT_AZIMUTHS: {
-            char *end;
             long v;
-            errno = 0;
-            v = strtol(value, &end, 10);
-            if (*value == '\0' || is_space(*value) || *end != '\0' ||
-                errno == ERANGE || v < 1 || v > LT_AZIMUTHS_MAX)
+            if (sp_parse_long(value, 1, LT_AZIMUTHS_MAX, &v) != 1)
                 return fail(args, "--azimuths must be an integer from 1 to %d, "
                                   "got '%s'", LT_AZIMUTHS_MAX, value);
             args->azimuths = (int)v;

@@ -3,14 +3,18 @@
  *
  * The protocol, on the group's own communicator: every message of a
  * worker (rank > 0) to rank 0 gets exactly one answer.
- *   worker -> 0   TAG_ASK     (empty)            first request
+ *   worker -> 0   TAG_ASK     (empty)            a request, sent AHEAD times
  *                 TAG_RESULT  header + result    an item done; asks again
- *                 TAG_FAILED  header + message   an item failed
+ *                 TAG_FAILED  header + message   an item failed; asks again
  *   0 -> worker   TAG_ITEM    long item          do this one
- *                 TAG_STOP    long status        no more: return status
- * Rank 0's calling thread only talks (MPI_Iprobe, then a receive, every
- * POLL_NS when nothing came); a thread of its own runs rank 0's items,
- * taking them from the same counter under a mutex. */
+ *                 TAG_STOP    long status        no more for this request
+ * A worker keeps AHEAD requests open, so the answer for its next item is
+ * there when it finishes one (no worker waits for rank 0), and ends when
+ * each has been answered with TAG_STOP.  Then rank 0 broadcasts the run's
+ * status, so every process returns the same one.  Rank 0's calling thread
+ * only talks (MPI_Iprobe, then a receive, every POLL_NS when nothing
+ * came); a thread of its own runs rank 0's items, taking them from the
+ * same counter under a mutex. */
 #define _POSIX_C_SOURCE 200809L
 
 #include <pthread.h>
@@ -25,7 +29,8 @@
 
 enum { TAG_ASK = 101, TAG_RESULT, TAG_FAILED, TAG_ITEM, TAG_STOP };
 
-#define POLL_NS 500000L /* 0.5 ms between polls when nothing came */
+#define POLL_NS 1000000L /* 1 ms between polls when nothing came */
+#define AHEAD 2           /* requests a worker keeps open */
 
 /* What precedes a result or a failure message. */
 typedef struct header {
@@ -133,7 +138,7 @@ static int lead(mw_group *g, const mw_job *job, char *msg, size_t msg_size)
 {
     leader L;
     pthread_t thread;
-    int active = g->size - 1, rc = MPI_SUCCESS, started = 0;
+    int active = AHEAD * (g->size - 1), rc = MPI_SUCCESS, started = 0; /* open requests */
     size_t cap = sizeof(header) + job->result_size;
     char *buf = malloc(cap);
 
@@ -197,46 +202,46 @@ static int lead(mw_group *g, const mw_job *job, char *msg, size_t msg_size)
     pthread_mutex_destroy(&L.lock);
     if (rc != MPI_SUCCESS)
         return mpi_fail(rc, "scheduling", msg, msg_size);
+    if ((rc = MPI_Bcast(&L.status, 1, MPI_LONG, 0, g->comm)) != MPI_SUCCESS)
+        return mpi_fail(rc, "sharing the status", msg, msg_size);
     return (int)L.status;
 }
 
 static int work(mw_group *g, const mw_job *job, char *msg, size_t msg_size)
 {
     char *buf = malloc(sizeof(header) + job->result_size + 1024);
-    int rc;
-    long cmd = 0;
+    int rc = MPI_SUCCESS, open = 0;
+    long cmd = 0, status = 0;
     MPI_Status st;
 
-    if (!buf) {
-        /* Still answer: ask, and fail the first item given. */
-        snprintf(msg, msg_size, "out of memory for a result");
-    }
-    rc = MPI_Send(NULL, 0, MPI_BYTE, 0, TAG_ASK, g->comm);
-    while (rc == MPI_SUCCESS) {
+    for (int k = 0; k < AHEAD && rc == MPI_SUCCESS; k++, open++)
+        rc = MPI_Send(NULL, 0, MPI_BYTE, 0, TAG_ASK, g->comm);
+    while (rc == MPI_SUCCESS && open > 0) {
         header h;
         int tag;
+        size_t n;
         rc = MPI_Recv(&cmd, 1, MPI_LONG, 0, MPI_ANY_TAG, g->comm, &st);
-        if (rc != MPI_SUCCESS)
-            break;
-        if (st.MPI_TAG == TAG_STOP) {
-            free(buf);
-            return (int)cmd;
-        }
+        open--;
+        if (rc != MPI_SUCCESS || st.MPI_TAG == TAG_STOP)
+            continue;
         memset(&h, 0, sizeof h);
         h.item = cmd;
         if (buf) {
             char text[1024] = "";
-            int status = job->run(job->user, cmd, buf + sizeof h, &h.size, text, sizeof text);
-            if (status == 0) {
+            int failed = job->run(job->user, cmd, buf + sizeof h, &h.size, text, sizeof text);
+            if (failed == 0) {
                 tag = TAG_RESULT;
                 if (h.size > job->result_size)
                     h.size = job->result_size;
             } else {
                 tag = TAG_FAILED;
-                h.status = status;
+                h.status = failed;
                 h.size = strlen(text);
                 memcpy(buf + sizeof h, text, h.size);
             }
+            memcpy(buf, &h, sizeof h);
+            n = sizeof h + h.size;
+            rc = MPI_Send(buf, (int)n, MPI_BYTE, 0, tag, g->comm);
         } else {
             static const char oom[] = "out of memory for a result";
             char small[sizeof h + sizeof oom];
@@ -245,13 +250,15 @@ static int work(mw_group *g, const mw_job *job, char *msg, size_t msg_size)
             memcpy(small, &h, sizeof h);
             memcpy(small + sizeof h, oom, h.size);
             rc = MPI_Send(small, (int)(sizeof h + h.size), MPI_BYTE, 0, TAG_FAILED, g->comm);
-            continue;
         }
-        memcpy(buf, &h, sizeof h);
-        rc = MPI_Send(buf, (int)(sizeof h + h.size), MPI_BYTE, 0, tag, g->comm);
+        open++;
     }
     free(buf);
-    return mpi_fail(rc, "waiting for work", msg, msg_size);
+    if (rc == MPI_SUCCESS)
+        rc = MPI_Bcast(&status, 1, MPI_LONG, 0, g->comm);
+    if (rc != MPI_SUCCESS)
+        return mpi_fail(rc, "waiting for work", msg, msg_size);
+    return (int)status;
 }
 
 int mw_run(mw_group *g, const mw_job *job, char *msg, size_t msg_size)

@@ -3,7 +3,6 @@
  * rs_args.error. */
 #include "args.h"
 
-#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -42,40 +41,11 @@ const char *rs_mode_name(rs_mode mode)
     return "unknown";
 }
 
-static int is_space(char c)
-{
-    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' ||
-           c == '\f';
-}
-
-/* A whole string as an integer in [lo, hi].  1: ok; 0: not an integer;
- * -1: out of range. */
-static int parse_int(const char *s, long lo, long hi, long *out)
-{
-    char *end;
-    long v;
-    if (*s == '\0' || is_space(*s))
-        return 0;
-    errno = 0;
-    v = strtol(s, &end, 10);
-    if (end == s || *end != '\0')
-        return 0;
-    if (errno == ERANGE || v < lo || v > hi)
-        return -1;
-    *out = v;
-    return 1;
-}
-
 /* A whole string as a finite double.  1: ok; 0: not a finite number. */
 static int parse_double(const char *s, double *out)
 {
-    char *end;
     double v;
-    if (*s == '\0' || is_space(*s))
-        return 0;
-    errno = 0;
-    v = strtod(s, &end);
-    if (end == s || *end != '\0' || !isfinite(v))
+    if (sp_parse_double(s, &v) != 1 || !isfinite(v))
         return 0;
     *out = v;
     return 1;
@@ -85,7 +55,7 @@ static const char *int_option(rs_args *args, const char *name, const char *val,
                               long lo, long hi, int *out)
 {
     long v;
-    int r = parse_int(val, lo, hi, &v);
+    int r = sp_parse_long(val, lo, hi, &v);
     if (r == 0)
         return fail(args, "%s: '%s' is not a whole number", name, val);
     if (r < 0)
@@ -358,4 +328,47 @@ const char *rs_args_parse(rs_args *args, int argc, char **argv)
     if (!args->out_png && derive_output(args))
         return args->error;
     return NULL;
+}
+
+/* The face's mode for the command line's. */
+static lr_mode face_mode(const rs_args *a)
+{
+    if (a->mode_auto)
+        return LR_MODE_AUTO;
+    switch (a->mode) {
+    case RS_MODE_FRESNEL: return LR_MODE_FRESNEL;
+    case RS_MODE_SCHLICK: return LR_MODE_SCHLICK;
+    case RS_MODE_RGB: return LR_MODE_RGB;
+    default: return LR_MODE_POLARIZED;
+    }
+}
+
+void rs_args_face_opts(const rs_args *a, lr_load_opts *lo, lr_render_opts *ro)
+{
+    lr_load_opts_init(lo);
+    lo->image_width = a->width;
+    lo->image_height = a->height;
+    lo->library_dirs = a->library;
+    lo->n_library_dirs = (size_t)a->n_library;
+    lr_render_opts_init(ro);
+    ro->mode = face_mode(a);
+    ro->tolerance = a->tolerance;
+    ro->width = a->width;
+    ro->height = a->height;
+    ro->depth = a->depth;
+    ro->wavelengths = a->mode_auto && !a->wavelengths_given ? 0 : a->wavelengths;
+    ro->cutoff = a->cutoff;
+    ro->aa = a->aa;
+    ro->no_dispersion = a->no_dispersion;
+    ro->threads = a->threads;
+}
+
+int rs_args_exit_status(lr_status st)
+{
+    if (st == LR_OK)
+        return 0;
+    return st == LR_ERROR_INVALID_ARGUMENT || st == LR_ERROR_IO || st == LR_ERROR_SCENE ||
+                   st == LR_ERROR_CAMERA
+               ? 2 /* bad input */
+               : 1 /* a render or output failure */;
 }

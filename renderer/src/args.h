@@ -21,6 +21,7 @@
 #include <stddef.h>
 
 #include "integrator.h"
+#include "lensrender/lensrender.h"
 
 #define RS_ARGS_ERROR_MAX 512
 #define RS_ARGS_PATH_MAX 4096
@@ -80,5 +81,18 @@ const char *rs_args_parse(rs_args *args, int argc, char **argv);
 
 /* The option name of a mode: "polarized", "fresnel", "schlick", "rgb". */
 const char *rs_mode_name(rs_mode mode);
+
+/* What the command line asks of the renderer's face, for every program
+ * that takes lensrender's command line (lensrender, lensrender-mpi): the
+ * load options (the image size, the -L directories, which point into
+ * args) and the render options (the mode, auto's tolerance, the size,
+ * depth, wavelengths (0 under --mode auto unless --wavelengths was given:
+ * auto's choice), cut-off, antialiasing, --no-dispersion, threads). */
+void rs_args_face_opts(const rs_args *args, lr_load_opts *lo, lr_render_opts *ro);
+
+/* lensrender's exit status for a face status: 0 for LR_OK; 2 (bad input)
+ * for an invalid argument, a file that cannot be read, a scene or camera
+ * error; 1 (a render or output failure) for the rest. */
+int rs_args_exit_status(lr_status st);
 
 #endif

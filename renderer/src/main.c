@@ -14,6 +14,7 @@
 
 #include "args.h"
 #include "library_path.h"
+#include "scene_messages.h"
 #include "lensrender/lensrender.h"
 #include "support/cli.h"
 #include "support/image.h"
@@ -87,47 +88,11 @@ static void say(const char *msg)
     sp_say("lensrender", "%s", msg);
 }
 
-/* The reader's warnings and #debug text, on stderr. */
-static void print_messages(const lr_scene *s, int quiet)
-{
-    if (quiet)
-        return;
-    for (size_t k = 0; k < lr_scene_message_count(s); k++) {
-        lr_message_kind kind;
-        const char *text = lr_scene_message(s, k, &kind);
-        if (kind == LR_MESSAGE_DEBUG)
-            fputs(text, stderr);
-        else
-            fprintf(stderr, "lensrender: %s\n", text);
-    }
-}
-
-static lr_mode face_mode(const rs_args *a)
-{
-    if (a->mode_auto)
-        return LR_MODE_AUTO;
-    switch (a->mode) {
-    case RS_MODE_FRESNEL: return LR_MODE_FRESNEL;
-    case RS_MODE_SCHLICK: return LR_MODE_SCHLICK;
-    case RS_MODE_RGB: return LR_MODE_RGB;
-    default: return LR_MODE_POLARIZED;
-    }
-}
-
 /* The terminal progress line (nothing when stderr is not a terminal). */
 static int show_progress(void *user, long long done, long long total)
 {
     rs_progress_line_show(user, done, total, done >= total);
     return 0;
-}
-
-/* Bad input exits 2, a failed render or output 1. */
-static int exit_status(lr_status st)
-{
-    return st == LR_ERROR_INVALID_ARGUMENT || st == LR_ERROR_IO || st == LR_ERROR_SCENE ||
-                   st == LR_ERROR_CAMERA
-               ? EXIT_BAD
-               : EXIT_RENDER;
 }
 
 /* Everything after the command line; returns the exit status. */
@@ -146,35 +111,21 @@ static int run(const rs_args *a)
     double t0 = sp_now_seconds();
 
     memset(&img, 0, sizeof img);
-    lr_load_opts_init(&lo);
-    lo.image_width = a->width;
-    lo.image_height = a->height;
-    lo.library_dirs = a->library;
-    lo.n_library_dirs = (size_t)a->n_library;
+    rs_args_face_opts(a, &lo, &ro);
     st = lr_scene_load(a->scene, &lo, &scene, &err);
-    print_messages(scene, a->quiet);
+    if (!a->quiet)
+        rs_print_scene_messages("lensrender", scene);
     if (st != LR_OK) {
         say(err.message);
-        status = exit_status(st);
+        status = rs_args_exit_status(st);
         goto done;
     }
     if (a->aa_threshold >= 0.0 && !a->quiet)
         fprintf(stderr, "lensrender: +A%g: every pixel gets %d x %d regular samples (the "
                 "threshold is not used)\n", a->aa_threshold, a->aa, a->aa);
-    lr_render_opts_init(&ro);
-    ro.mode = face_mode(a);
-    ro.tolerance = a->tolerance;
-    ro.width = a->width;
-    ro.height = a->height;
-    ro.depth = a->depth;
-    ro.wavelengths = a->mode_auto && !a->wavelengths_given ? 0 : a->wavelengths;
-    ro.cutoff = a->cutoff;
-    ro.aa = a->aa;
-    ro.no_dispersion = a->no_dispersion;
-    ro.threads = a->threads;
     if ((st = lr_renderer_create(scene, &ro, &r, &err)) != LR_OK) {
         say(err.message);
-        status = exit_status(st);
+        status = rs_args_exit_status(st);
         goto done;
     }
     if (a->mode_auto && !a->quiet)

@@ -3,8 +3,10 @@
 
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
@@ -38,6 +40,44 @@ const char *sp_format(char *buf, size_t size, const char *fmt, ...)
     vsnprintf(buf, size, fmt, ap);
     va_end(ap);
     return buf;
+}
+
+static int starts_blank(const char *s)
+{
+    return *s == '\0' || *s == ' ' || *s == '\t' || *s == '\n' || *s == '\r' || *s == '\v' ||
+           *s == '\f';
+}
+
+int sp_parse_double(const char *s, double *out)
+{
+    char *end;
+    double v;
+    if (starts_blank(s))
+        return 0;
+    errno = 0;
+    v = strtod(s, &end);
+    if (end == s || *end != '\0')
+        return 0;
+    if (errno == ERANGE && isinf(v))
+        return -1;
+    *out = v;
+    return 1;
+}
+
+int sp_parse_long(const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    long v;
+    if (starts_blank(s))
+        return 0;
+    errno = 0;
+    v = strtol(s, &end, 10);
+    if (end == s || *end != '\0')
+        return 0;
+    if (errno == ERANGE || v < lo || v > hi)
+        return -1;
+    *out = v;
+    return 1;
 }
 
 int sp_print_text(const char *const *parts, size_t n)

@@ -7,10 +7,12 @@
 #include <unistd.h>
 
 #include "mpi_launch.h"
+#include "test_files.h"
 
 void ml_environment(void)
 {
     setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 1);
+    setenv("OMPI_MCA_orte_execute_quiet", "1", 1); /* mpirun -q: no banners of its own */
     if (geteuid() == 0) {
         setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 1);
         setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 1);
@@ -50,4 +52,14 @@ int ml_count_lines(const char *text, const char *prefix)
         line = end ? end + 1 : NULL;
     }
     return count;
+}
+
+int ml_same_file(const char *a, const char *b)
+{
+    size_t na, nb;
+    char *x = tf_read(a, &na), *y = tf_read(b, &nb);
+    int same = x && y && na == nb && memcmp(x, y, na) == 0;
+    free(x);
+    free(y);
+    return same;
 }

@@ -7,7 +7,8 @@
  * The launcher is the one the build found (LP_MPIEXEC, its -n flag
  * LP_MPIEXEC_NUMPROC_FLAG).  Open MPI's settings for this machine go in
  * through the environment, which other launchers ignore: more processes
- * than cores are allowed (OMPI_MCA_rmaps_base_oversubscribe), and a test
+ * than cores are allowed (OMPI_MCA_rmaps_base_oversubscribe), mpirun
+ * prints no banners of its own (OMPI_MCA_orte_execute_quiet), and a test
  * run as root (containers, CI) may start them
  * (OMPI_ALLOW_RUN_AS_ROOT{,_CONFIRM}).  The whole run is bounded by
  * timeout(1): `seconds`, then SIGTERM (mpirun then ends every process),
@@ -29,6 +30,9 @@ int ml_run(int n, int seconds, const char *program, const char *const args[], tp
 /* The environment ml_run gives the launcher (above); also for a program
  * of the MPI build run without the launcher (a run of one process). */
 void ml_environment(void);
+
+/* Whether the files at a and b hold the same bytes (both readable). */
+int ml_same_file(const char *a, const char *b);
 
 /* The number of lines of text that start with prefix. */
 int ml_count_lines(const char *text, const char *prefix);

@@ -51,16 +51,6 @@ static void sweep(int ranks, const char *docs, const char *work)
     tp_result_free(&r);
 }
 
-static int same_file(const char *a, const char *b)
-{
-    size_t na, nb;
-    char *x = tf_read(a, &na), *y = tf_read(b, &nb);
-    int same = x && y && na == nb && memcmp(x, y, na) == 0;
-    free(x);
-    free(y);
-    return same;
-}
-
 static void na_sweep(int ranks, const char *csv, const char *png)
 {
     char scene[4096];
@@ -123,7 +113,7 @@ int main(void)
     snprintf(pa3, sizeof pa3, "%s/mpi_sweep_na3.png", LP_TEST_TMP);
     na_sweep(0, na1, pa1);
     na_sweep(3, na3, pa3);
-    CHECK(same_file(na1, na3), "extinction_na: the CSV of 3 processes differs from one process's");
-    CHECK(same_file(pa1, pa3), "extinction_na: the chart of 3 processes differs from one process's");
+    CHECK(ml_same_file(na1, na3), "extinction_na: the CSV of 3 processes differs from one process's");
+    CHECK(ml_same_file(pa1, pa3), "extinction_na: the chart of 3 processes differs from one process's");
     return check_finish("test_mpi_sweep");
 }

@@ -3,10 +3,11 @@
  *
  * Items are numbered 0 .. n_items - 1 and handed out in that order, one
  * at a time, to whichever process asks next: a process that finishes
- * early takes more.  Rank 0 hands them out AND does items itself (on a
- * thread of its own, while its calling thread answers the others, polling
- * for their messages every half millisecond), so no core idles as a mere
- * scheduler.  Each item is run exactly once, on one process; its result
+ * early takes more (each other process holds at most two items: the one
+ * it runs and the next).  Rank 0 hands them out AND does items itself (on
+ * a thread of its own, while its calling thread answers the others,
+ * polling for their messages every millisecond), so no core idles as a
+ * mere scheduler.  Each item is run exactly once, on one process; its result
  * (at most result_size bytes) travels to rank 0, which passes it to
  * done().  Which process runs which item varies from run to run: a result
  * must depend on the item alone for the gathered whole to be the same for

@@ -25,6 +25,14 @@ const char *sp_format(char *buf, size_t size, const char *fmt, ...)
 #endif
     ;
 
+/* A whole string as a number: no white space before it, nothing after.
+ * sp_parse_double: 1 and *out (which may be +-inf or NaN: the caller
+ * decides), 0 when it is not a number, -1 when a finite literal is too
+ * large (overflow).  sp_parse_long (base 10): 1 and *out, 0 when it is not
+ * an integer, -1 when it is outside [lo, hi].  *out is untouched unless 1. */
+int sp_parse_double(const char *s, double *out);
+int sp_parse_long(const char *s, long lo, long hi, long *out);
+
 /* --help: the n parts of the text on stdout, in order, flushed.  0, or -1
  * when stdout could not be written. */
 int sp_print_text(const char *const *parts, size_t n);
