@@ -506,13 +506,22 @@ static int make_lane_tables(rs_integrator *it)
     return 0;
 }
 
+/* The parity (0 or 1) of floor(v + 1e-10) for any v: fmod is exact at
+ * every magnitude (a double beyond 2^53 is an integer), where a cast to
+ * long overflows beyond 2^63; not finite: 0. */
+static int floor_parity(double v)
+{
+    double r = fmod(floor(v + 1e-10), 2.0);
+    return r != 0.0 && r == r; /* -1 or 1: odd; NaN: 0 */
+}
+
 static rs_color pigment_at(const rs_pigment *p, lp_vec3 x)
 {
     if (p->type != RS_PIGMENT_CHECKER)
         return p->color[0];
     lp_vec3 q = rs_xf_point(&p->to_pattern, x);
-    long s = (long)floor(q.x + 1e-10) + (long)floor(q.y + 1e-10) + (long)floor(q.z + 1e-10);
-    return p->color[(s & 1) ? 1 : 0];
+    int s = floor_parity(q.x) + floor_parity(q.y) + floor_parity(q.z);
+    return p->color[s & 1];
 }
 
 /* Does the straight segment x + t d, t in (t0, t1), meet the lens's rim?
