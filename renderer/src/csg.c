@@ -4,25 +4,20 @@
 #include <string.h>
 
 #include "csg.h"
+#include "support/vec.h"
 
-static double dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static lp_vec3 sub(lp_vec3 a, lp_vec3 b) { return (lp_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
-static lp_vec3 madd(lp_vec3 a, lp_vec3 b, double s)
-{
-    return (lp_vec3){a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
-}
 
 /* Inside a cone (a cylinder when r1 = r2) from base to cap, in object
  * space: between the end planes and within the radius there. */
 static int inside_cone(lp_vec3 base, double r1, lp_vec3 cap, double r2, lp_vec3 p)
 {
-    lp_vec3 ax = sub(cap, base), w = sub(p, base);
-    double h2 = dot(ax, ax);
+    lp_vec3 ax = v3_sub(cap, base), w = v3_sub(p, base);
+    double h2 = v3_dot(ax, ax);
     if (!(h2 > 0.0))
         return 0;
-    double s = dot(w, ax) / h2, r = r1 + (r2 - r1) * s;
-    lp_vec3 q = madd(w, ax, -s);
-    return s > 0.0 && s < 1.0 && dot(q, q) < r * r;
+    double s = v3_dot(w, ax) / h2, r = r1 + (r2 - r1) * s;
+    lp_vec3 q = v3_madd(w, ax, -s);
+    return s > 0.0 && s < 1.0 && v3_dot(q, q) < r * r;
 }
 
 /* A primitive's inside in its object space (POV-Ray's: an open cylinder
@@ -31,10 +26,10 @@ static int inside_primitive(const rs_object *o, lp_vec3 p)
 {
     switch (o->type) {
     case RS_OBJ_PLANE:
-        return dot(o->u.plane.normal, p) < o->u.plane.distance;
+        return v3_dot(o->u.plane.normal, p) < o->u.plane.distance;
     case RS_OBJ_SPHERE: {
-        lp_vec3 d = sub(p, o->u.sphere.center);
-        return dot(d, d) < o->u.sphere.radius * o->u.sphere.radius;
+        lp_vec3 d = v3_sub(p, o->u.sphere.center);
+        return v3_dot(d, d) < o->u.sphere.radius * o->u.sphere.radius;
     }
     case RS_OBJ_BOX: {
         lp_vec3 a = o->u.box.corner1, b = o->u.box.corner2;
@@ -103,9 +98,9 @@ int rs_csg_intersect(const rs_object *o, lp_vec3 origin, lp_vec3 dir, double t_m
             if (!rs_object_intersect(m, origin, dir, t, best, &h))
                 break;
             t = h.t;
-            double e = RS_CSG_STEP * (1.0 + sqrt(dot(h.point, h.point)));
-            if (rs_object_inside(o, madd(h.point, dir, -e)) !=
-                rs_object_inside(o, madd(h.point, dir, e))) {
+            double e = RS_CSG_STEP * (1.0 + sqrt(v3_dot(h.point, h.point)));
+            if (rs_object_inside(o, v3_madd(h.point, dir, -e)) !=
+                rs_object_inside(o, v3_madd(h.point, dir, e))) {
                 *hit = h;
                 best = h.t;
                 found = 1;

@@ -45,6 +45,7 @@
 #include "packet.h"
 #include "shapes.h"
 #include "emitter.h"
+#include "support/vec.h"
 
 #define RS_MAX_FRAMES 400
 #define RS_PI 3.14159265358979323846
@@ -432,21 +433,7 @@ static lp_ray *bundle_push(bundle *b, int lane)
     return &b->r[b->n++];
 }
 
-/* ---- small vector helpers ---- */
-static double dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static lp_vec3 cross(lp_vec3 a, lp_vec3 b)
-{
-    return (lp_vec3){a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-static lp_vec3 unit(lp_vec3 a)
-{
-    double l = sqrt(dot(a, a));
-    return l > 0.0 ? (lp_vec3){a.x / l, a.y / l, a.z / l} : a;
-}
-static lp_vec3 madd(lp_vec3 a, lp_vec3 b, double s)
-{
-    return (lp_vec3){a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
-}
+/* ---- small colour helpers ---- */
 static double chan(rs_color c, int k) { return k == 0 ? c.r : (k == 1 ? c.g : c.b); }
 static rs_color mul(rs_color a, rs_color b) { return (rs_color){a.r * b.r, a.g * b.g, a.b * b.b}; }
 
@@ -596,7 +583,7 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
     const rs_scene *sc = it->scene;
     const rs_light *l = &sc->lights[k];
     lp_vec3 d = {l->position.x - x.x, l->position.y - x.y, l->position.z - x.z};
-    double dist = sqrt(dot(d, d));
+    double dist = sqrt(v3_dot(d, d));
     if (!(dist > 0.0))
         return 1.0;
     d = (lp_vec3){d.x / dist, d.y / dist, d.z / dist};
@@ -604,7 +591,7 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
     sg.sc = sc;
     sg.x = x;
     sg.d = d;
-    sg.eps = 1e-9 * (1.0 + sqrt(dot(x, x)));
+    sg.eps = 1e-9 * (1.0 + sqrt(v3_dot(x, x)));
     sg.dist = dist;
     sg.np = 0;
     int blocked = 0;
@@ -626,23 +613,23 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
     lp_vec3 v[2];
     int nv;
     lp_vec3 pv = l->polarization;
-    pv = madd(pv, d, -dot(pv, d));
-    if (l->polarized && dot(pv, pv) > 0.0) {
+    pv = v3_madd(pv, d, -v3_dot(pv, d));
+    if (l->polarized && v3_dot(pv, pv) > 0.0) {
         nv = 1;
         I[0] = 1.0;
-        v[0] = unit(pv);
+        v[0] = v3_unit_or_self(pv);
     } else {
         lp_vec3 hh = fabs(d.y) < 0.9 ? (lp_vec3){0, 1, 0} : (lp_vec3){1, 0, 0};
         nv = 2;
         I[0] = I[1] = 0.5;
-        v[0] = unit(cross(d, hh));
-        v[1] = cross(d, v[0]);
+        v[0] = v3_unit_or_self(v3_cross(d, hh));
+        v[1] = v3_cross(d, v[0]);
     }
     for (int q = 0; q < np; q++) {
         lp_vec3 ax = sc->objects[pol[q]].u.polarizer.axis;
-        ax = unit(madd(ax, d, -dot(ax, d)));
+        ax = v3_unit_or_self(v3_madd(ax, d, -v3_dot(ax, d)));
         for (int m = 0; m < nv; m++) {
-            double c = dot(v[m], ax);
+            double c = v3_dot(v[m], ax);
             I[m] *= c * c;
             v[m] = ax;
         }
@@ -661,14 +648,14 @@ static double highlight(const rs_finish *f, lp_vec3 n, lp_vec3 d, lp_vec3 l)
 {
     double s = 0.0;
     if (f->phong > 0.0) {
-        lp_vec3 r = madd(d, n, -2.0 * dot(d, n));
-        double c = dot(r, l);
+        lp_vec3 r = v3_madd(d, n, -2.0 * v3_dot(d, n));
+        double c = v3_dot(r, l);
         if (c > 0.0)
             s += f->phong * pow(c, f->phong_size);
     }
     if (f->specular > 0.0) {
-        lp_vec3 hv = unit((lp_vec3){l.x - d.x, l.y - d.y, l.z - d.z});
-        double c = dot(hv, n);
+        lp_vec3 hv = v3_unit_or_self((lp_vec3){l.x - d.x, l.y - d.y, l.z - d.z});
+        double c = v3_dot(hv, n);
         if (c > 0.0)
             s += f->specular * pow(c, 1.0 / f->roughness);
     }
@@ -694,16 +681,16 @@ static void shade_begin(const rs_integrator *it, const rs_hit *h, lp_vec3 dir, f
     const rs_finish *f = &o->finish;
     sp->h = h;
     sp->pig = pigment_at(&o->pigment, h->point);
-    sp->x = madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
+    sp->x = v3_madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(v3_dot(h->point, h->point))));
     sp->cb = fr->cb;
     sp->s = fr->hs;
     sp->reach = fr->reach;
     for (size_t k = 0; k < sc->n_lights; k++) {
         const rs_light *l = &sc->lights[k];
         lp_vec3 x = sp->x;
-        lp_vec3 ld = unit((lp_vec3){l->position.x - x.x, l->position.y - x.y,
+        lp_vec3 ld = v3_unit_or_self((lp_vec3){l->position.x - x.x, l->position.y - x.y,
                                     l->position.z - x.z});
-        double c = dot(ld, h->normal);
+        double c = v3_dot(ld, h->normal);
         sp->s[k] = highlight(f, h->normal, dir, ld);
         sp->cb[k] = c > 0.0 ? (f->brilliance == 1.0 ? c : pow(c, f->brilliance)) : -1.0;
         sp->reach[k] = NAN;
@@ -761,7 +748,7 @@ static double reflectivity(const band *b, const rs_object *o, const rs_hit *h, l
     if (!f->fresnel)
         return rmax;
     double rmin = band_reflectance(b, f->reflection_min);
-    double ci = -dot(d, h->normal), n = o->ior;
+    double ci = -v3_dot(d, h->normal), n = o->ior;
     double F = 0.0;
     if (ci > 1.0)
         ci = 1.0;
@@ -866,8 +853,8 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
         shade(it, &it->lanes[lane[k]], &sp, emit_sum, &out[k]);
     if (!has_reflection(&ob->finish) || level >= it->max_level || f + 1 >= RS_MAX_FRAMES)
         return;
-    lp_vec3 rd = unit(madd(d, h.normal, -2.0 * dot(d, h.normal)));
-    lp_vec3 x = madd(h.point, h.normal, 1e-9 * (1.0 + sqrt(dot(h.point, h.point))));
+    lp_vec3 rd = v3_unit_or_self(v3_madd(d, h.normal, -2.0 * v3_dot(d, h.normal)));
+    lp_vec3 x = v3_madd(h.point, h.normal, 1e-9 * (1.0 + sqrt(v3_dot(h.point, h.point))));
     /* The mirror ray, shared by the lanes of equal reflectivity (they
      * carry the same weight on). */
     for (int k = 0; k < n; k++) {
@@ -907,8 +894,8 @@ static emit_ctx emit_ctx_make(bundle *out, lp_vec3 d, long wavelet)
     lp_vec3 h = fabs(d.y) < 0.9 ? (lp_vec3){0, 1, 0} : (lp_vec3){1, 0, 0};
     emit_ctx e;
     e.out = out;
-    e.v1 = unit(cross(d, h));
-    e.v2 = cross(d, e.v1);
+    e.v1 = v3_unit_or_self(v3_cross(d, h));
+    e.v2 = v3_cross(d, e.v1);
     e.wavelet = wavelet;
     e.lane = 0;
     return e;
@@ -959,8 +946,8 @@ static void mirror_pol(rs_worker *w, const int *lane, int n, const rs_object *ob
 {
     const rs_integrator *it = w->it;
     lp_vec3 nv = h->normal;
-    lp_vec3 rd = unit(madd(d, nv, -2.0 * dot(d, nv)));
-    lp_vec3 x = madd(h->point, nv, 1e-9 * (1.0 + sqrt(dot(h->point, h->point))));
+    lp_vec3 rd = v3_unit_or_self(v3_madd(d, nv, -2.0 * v3_dot(d, nv)));
+    lp_vec3 x = v3_madd(h->point, nv, 1e-9 * (1.0 + sqrt(v3_dot(h->point, h->point))));
     for (int k = 0; k < n; k++) {
         double r = reflectivity(&it->lanes[lane[k]], ob, h, d);
         fr->val[k] = r;
@@ -984,7 +971,7 @@ static void mirror_pol(rs_worker *w, const int *lane, int n, const rs_object *ob
                 return;
             *p = fr->child.r[i];
             p->intensity *= r;
-            p->vp = madd(p->vp, nv, -2.0 * dot(p->vp, nv));
+            p->vp = v3_madd(p->vp, nv, -2.0 * v3_dot(p->vp, nv));
             p->kphi += 1;
             p->op += h->t;
         }
@@ -1157,10 +1144,10 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
         fr->child.n = 0;
         trace_pol(w, lane, n, h.point, d, level, weight, h.object, f + 1, &fr->child);
         lp_vec3 ax = ob->u.polarizer.axis;
-        ax = unit(madd(ax, d, -dot(ax, d)));
+        ax = v3_unit_or_self(v3_madd(ax, d, -v3_dot(ax, d)));
         for (size_t i = 0; i < fr->child.n; i++) {
             lp_ray r = fr->child.r[i];
-            double c = dot(r.vp, ax);
+            double c = v3_dot(r.vp, ax);
             if (c == 0.0)
                 continue;
             r.intensity *= c * c;

@@ -17,6 +17,7 @@
 
 #include "csg.h"
 #include "parse_internal.h"
+#include "support/vec.h"
 
 /* An rs_object is about 2.5 kB (a lens description holds two glasses), so
  * 100,000 objects take about 250 MB; a scene asking for more is refused
@@ -1641,11 +1642,6 @@ static int parse_object_modifiers(parser *p, rs_object *o)
     return close_block(p, name);
 }
 
-static int vec_finite(lp_vec3 v)
-{
-    return isfinite(v.x) && isfinite(v.y) && isfinite(v.z);
-}
-
 static int parse_plane(parser *p, rs_object *o)
 {
     if (open_block(p, "plane") != 0)
@@ -1965,8 +1961,8 @@ static int parse_lens(parser *p, rs_object *o, const rs_token *kw)
         d->crystal.axis = rs_xf_dir(&xf, crystal_axis); /* lensprim wants it in the world */
     if ((isfinite(r1) && !isfinite(d->radius1)) || (isfinite(r2) && !isfinite(d->radius2)) ||
         !isfinite(d->thickness) || !isfinite(d->diameter) || !isfinite(d->diameter2) ||
-        !vec_finite(d->position) || !vec_finite(d->axis) ||
-        (d->uniaxial && !vec_finite(d->crystal.axis)))
+        !v3_finite(d->position) || !v3_finite(d->axis) ||
+        (d->uniaxial && !v3_finite(d->crystal.axis)))
         return error_at(p, kw->line, kw->column,
                         "lens: a value is not finite after the transforms");
     if ((r1 != 0.0 && d->radius1 == 0.0) || (r2 != 0.0 && d->radius2 == 0.0))
@@ -2042,7 +2038,7 @@ static int parse_polarizer(parser *p, rs_object *o, const rs_token *kw)
     o->u.polarizer.normal = n;
     o->u.polarizer.axis = a;
     o->u.polarizer.radius = r * k;
-    if (!vec_finite(o->u.polarizer.center) || !isfinite(o->u.polarizer.radius))
+    if (!v3_finite(o->u.polarizer.center) || !isfinite(o->u.polarizer.radius))
         return error_at(p, kw->line, kw->column,
                         "polarizer: a value is not finite after the transforms");
     if (!(o->u.polarizer.radius > 0.0))
@@ -2204,7 +2200,7 @@ static int transform_object(parser *p, const rs_token *kw, rs_object *o, const r
             d->diameter2 *= k;
             d->position = rs_xf_point(T, d->position);
             d->axis = (lp_vec3){ ax.x / k, ax.y / k, ax.z / k };
-            if (!vec_finite(d->position) || !isfinite(d->thickness) ||
+            if (!v3_finite(d->position) || !isfinite(d->thickness) ||
                 !isfinite(d->diameter) || !isfinite(d->diameter2) || !(d->thickness > 0.0))
                 return error_at(p, kw->line, kw->column,
                                 "lens: a value is not finite after the transforms");
@@ -2222,7 +2218,7 @@ static int transform_object(parser *p, const rs_token *kw, rs_object *o, const r
             o->u.polarizer.normal = n;
             o->u.polarizer.axis = a;
             o->u.polarizer.radius *= k;
-            if (!vec_finite(o->u.polarizer.center) || !(o->u.polarizer.radius > 0.0) ||
+            if (!v3_finite(o->u.polarizer.center) || !(o->u.polarizer.radius > 0.0) ||
                 !isfinite(o->u.polarizer.radius))
                 return error_at(p, kw->line, kw->column,
                                 "polarizer: a value is not finite after the transforms");
@@ -2241,7 +2237,7 @@ static int transform_object(parser *p, const rs_token *kw, rs_object *o, const r
 static int transform_light(parser *p, const rs_token *kw, rs_light *l, const rs_transform *T)
 {
     l->position = rs_xf_point(T, l->position);
-    if (!vec_finite(l->position))
+    if (!v3_finite(l->position))
         return error_at(p, kw->line, kw->column,
                         "light_source: the position is not finite after the transforms");
     if (l->polarized && !normalize(rs_xf_dir(T, l->polarization), &l->polarization))
@@ -2774,7 +2770,7 @@ static int parse_light(parser *p, rs_group *g)
     if (close_block(p, "light_source") != 0)
         return -1;
     l.position = rs_xf_point(&xf, l.position);
-    if (!vec_finite(l.position))
+    if (!v3_finite(l.position))
         return error_at(p, kw.line, kw.column,
                         "light_source: the position is not finite after the transforms");
     if (l.polarized && !normalize(rs_xf_dir(&xf, l.polarization), &l.polarization))

@@ -2,13 +2,8 @@
 #include <math.h>
 
 #include "round_shapes.h"
+#include "support/vec.h"
 
-static double dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static lp_vec3 sub(lp_vec3 a, lp_vec3 b) { return (lp_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
-static lp_vec3 madd(lp_vec3 a, lp_vec3 b, double s)
-{
-    return (lp_vec3){a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
-}
 
 /* Keep the candidate s if it is nearer than *best. */
 static void keep(double s, lp_vec3 ns, double t0, double *best, lp_vec3 *n)
@@ -22,19 +17,19 @@ static void keep(double s, lp_vec3 ns, double t0, double *best, lp_vec3 *n)
 int rs_cone_hit(lp_vec3 base, double r1, lp_vec3 cap, double r2, int open, lp_vec3 o,
                 lp_vec3 d, double t0, double t1, double *t, lp_vec3 *n)
 {
-    lp_vec3 ax = sub(cap, base);
-    double h = sqrt(dot(ax, ax));
+    lp_vec3 ax = v3_sub(cap, base);
+    double h = sqrt(v3_dot(ax, ax));
     if (!(h > 0.0))
         return 0;
     ax = (lp_vec3){ax.x / h, ax.y / h, ax.z / h};
     double k = (r2 - r1) / h;
-    lp_vec3 w = sub(o, base);
-    double ws = dot(w, ax), ds = dot(d, ax);
-    lp_vec3 wp = madd(w, ax, -ws), dp = madd(d, ax, -ds);
+    lp_vec3 w = v3_sub(o, base);
+    double ws = v3_dot(w, ax), ds = v3_dot(d, ax);
+    lp_vec3 wp = v3_madd(w, ax, -ws), dp = v3_madd(d, ax, -ds);
     double rw = r1 + k * ws;
-    double A = dot(dp, dp) - k * k * ds * ds;
-    double B = dot(wp, dp) - k * rw * ds;
-    double C = dot(wp, wp) - rw * rw;
+    double A = v3_dot(dp, dp) - k * k * ds * ds;
+    double B = v3_dot(wp, dp) - k * rw * ds;
+    double C = v3_dot(wp, wp) - rw * rw;
     double best = t1;
     lp_vec3 bn = {0, 0, 0};
 
@@ -49,8 +44,8 @@ int rs_cone_hit(lp_vec3 base, double r1, lp_vec3 cap, double r2, int open, lp_ve
             double s = roots[i], along = ws + s * ds;
             if (!(along >= 0.0 && along <= h) || !(r1 + k * along >= 0.0))
                 continue;
-            lp_vec3 pp = madd(wp, dp, s);
-            keep(s, madd(pp, ax, -(r1 + k * along) * k), t0, &best, &bn);
+            lp_vec3 pp = v3_madd(wp, dp, s);
+            keep(s, v3_madd(pp, ax, -(r1 + k * along) * k), t0, &best, &bn);
         }
     }
     /* the end discs */
@@ -60,8 +55,8 @@ int rs_cone_hit(lp_vec3 base, double r1, lp_vec3 cap, double r2, int open, lp_ve
             if (!(r > 0.0))
                 continue;
             double s = (plane - ws) / ds;
-            lp_vec3 pp = madd(wp, dp, s);
-            if (dot(pp, pp) <= r * r)
+            lp_vec3 pp = v3_madd(wp, dp, s);
+            if (v3_dot(pp, pp) <= r * r)
                 keep(s, e ? ax : (lp_vec3){-ax.x, -ax.y, -ax.z}, t0, &best, &bn);
         }
     }
@@ -137,7 +132,7 @@ int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, do
                  double *t, lp_vec3 *n)
 {
     double R2 = major * major, r2 = minor * minor, bound = major + minor;
-    double dd = dot(d, d), od = dot(o, d), oo = dot(o, o);
+    double dd = v3_dot(d, d), od = v3_dot(o, d), oo = v3_dot(o, o);
     /* the bounding sphere |p| <= major + minor */
     double disc = od * od - dd * (oo - bound * bound);
     if (!(dd > 0.0) || disc < 0.0)
@@ -152,8 +147,8 @@ int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, do
         return 0;
     /* the quartic in s = t - lo, from the point where the ray enters the
      * bounding sphere (no cancellation from a far origin) */
-    lp_vec3 q = madd(o, d, lo);
-    double qd = dot(q, d), qq = dot(q, q);
+    lp_vec3 q = v3_madd(o, d, lo);
+    double qd = v3_dot(q, d), qq = v3_dot(q, q);
     double a2 = dd, a1 = 2.0 * qd, a0 = qq + R2 - r2;
     double b2 = d.x * d.x + d.z * d.z, b1 = 2.0 * (q.x * d.x + q.z * d.z),
            b0 = q.x * q.x + q.z * q.z;
@@ -165,8 +160,8 @@ int rs_torus_hit(double major, double minor, lp_vec3 o, lp_vec3 d, double t0, do
         double root = lo + roots[i];
         if (!(root > t0 && root < t1))
             continue;
-        lp_vec3 p = madd(o, d, root);
-        double g = dot(p, p) + R2 - r2;
+        lp_vec3 p = v3_madd(o, d, root);
+        double g = v3_dot(p, p) + R2 - r2;
         *t = root;
         *n = (lp_vec3){g * p.x - 2.0 * R2 * p.x, g * p.y, g * p.z - 2.0 * R2 * p.z};
         return 1;

@@ -13,18 +13,8 @@
 #include "csg.h"
 #include "round_shapes.h"
 #include "shapes.h"
+#include "support/vec.h"
 
-static double dot(lp_vec3 a, lp_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-static lp_vec3 sub(lp_vec3 a, lp_vec3 b) { return (lp_vec3){a.x - b.x, a.y - b.y, a.z - b.z}; }
-static lp_vec3 madd(lp_vec3 a, lp_vec3 b, double s)
-{
-    return (lp_vec3){a.x + s * b.x, a.y + s * b.y, a.z + s * b.z};
-}
-static lp_vec3 unit(lp_vec3 a)
-{
-    double l = sqrt(dot(a, a));
-    return l > 0.0 ? (lp_vec3){a.x / l, a.y / l, a.z / l} : a;
-}
 
 /* Smallest root of a t^2 + 2 b t + c = 0 in (t0, t1). */
 static int quadratic(double a, double b, double c, double t0, double t1, double *t)
@@ -55,14 +45,14 @@ static int quadratic(double a, double b, double c, double t0, double t1, double 
 static int disc_hit(lp_vec3 c, lp_vec3 n, double radius, double hole, lp_vec3 o, lp_vec3 d,
                     double t0, double t1, double *t)
 {
-    double dn = dot(d, n);
+    double dn = v3_dot(d, n);
     if (dn == 0.0)
         return 0;
-    double s = dot(sub(c, o), n) / dn;
+    double s = v3_dot(v3_sub(c, o), n) / dn;
     if (!(s > t0 && s < t1))
         return 0;
-    lp_vec3 p = sub(madd(o, d, s), c);
-    double r2 = dot(p, p);
+    lp_vec3 p = v3_sub(v3_madd(o, d, s), c);
+    double r2 = v3_dot(p, p);
     if (r2 > radius * radius || r2 < hole * hole)
         return 0;
     *t = s;
@@ -84,7 +74,7 @@ int rs_object_intersect(const rs_object *ob, lp_vec3 origin, lp_vec3 dir, double
             return 0;
         hit->t = h.t;
         hit->point = h.point;
-        hit->normal = dot(h.normal, dir) > 0.0 ? (lp_vec3){-h.normal.x, -h.normal.y, -h.normal.z}
+        hit->normal = v3_dot(h.normal, dir) > 0.0 ? (lp_vec3){-h.normal.x, -h.normal.y, -h.normal.z}
                                                 : h.normal;
         hit->lens_surface = h.surface;
         return 1;
@@ -94,8 +84,8 @@ int rs_object_intersect(const rs_object *ob, lp_vec3 origin, lp_vec3 dir, double
         if (!disc_hit(c, n, ob->u.polarizer.radius, 0.0, origin, dir, t_min, t_max, &t))
             return 0;
         hit->t = t;
-        hit->point = madd(origin, dir, t);
-        hit->normal = dot(n, dir) > 0.0 ? (lp_vec3){-n.x, -n.y, -n.z} : n;
+        hit->point = v3_madd(origin, dir, t);
+        hit->normal = v3_dot(n, dir) > 0.0 ? (lp_vec3){-n.x, -n.y, -n.z} : n;
         hit->lens_surface = LP_SURFACE_NONE;
         return 1;
     }
@@ -104,21 +94,21 @@ int rs_object_intersect(const rs_object *ob, lp_vec3 origin, lp_vec3 dir, double
     switch (ob->type) {
     case RS_OBJ_PLANE: {
         lp_vec3 n = ob->u.plane.normal;
-        double dn = dot(d, n);
+        double dn = v3_dot(d, n);
         if (dn == 0.0)
             return 0;
-        t = (ob->u.plane.distance * dot(n, n) - dot(o, n)) / dn;
+        t = (ob->u.plane.distance * v3_dot(n, n) - v3_dot(o, n)) / dn;
         if (!(t > t_min && t < t_max))
             return 0;
         n_obj = n;
         break;
     }
     case RS_OBJ_SPHERE: {
-        lp_vec3 oc = sub(o, ob->u.sphere.center);
+        lp_vec3 oc = v3_sub(o, ob->u.sphere.center);
         double r = ob->u.sphere.radius;
-        if (!quadratic(dot(d, d), dot(oc, d), dot(oc, oc) - r * r, t_min, t_max, &t))
+        if (!quadratic(v3_dot(d, d), v3_dot(oc, d), v3_dot(oc, oc) - r * r, t_min, t_max, &t))
             return 0;
-        n_obj = sub(madd(o, d, t), ob->u.sphere.center);
+        n_obj = v3_sub(v3_madd(o, d, t), ob->u.sphere.center);
         break;
     }
     case RS_OBJ_BOX: {
@@ -190,10 +180,10 @@ int rs_object_intersect(const rs_object *ob, lp_vec3 origin, lp_vec3 dir, double
     default:
         return 0;
     }
-    lp_vec3 n = unit(rs_xf_normal(&ob->xf, n_obj));
+    lp_vec3 n = v3_unit_or_self(rs_xf_normal(&ob->xf, n_obj));
     hit->t = t;
-    hit->point = madd(origin, dir, t);
-    hit->normal = dot(n, dir) > 0.0 ? (lp_vec3){-n.x, -n.y, -n.z} : n;
+    hit->point = v3_madd(origin, dir, t);
+    hit->normal = v3_dot(n, dir) > 0.0 ? (lp_vec3){-n.x, -n.y, -n.z} : n;
     hit->lens_surface = LP_SURFACE_NONE;
     return 1;
 }

@@ -41,6 +41,13 @@ static inline lp_vec3 v3_unit(lp_vec3 a)
     return v3(a.x / l, a.y / l, a.z / l);
 }
 
+/* a / |a|, or a itself when |a| is 0 or not a number. */
+static inline lp_vec3 v3_unit_or_self(lp_vec3 a)
+{
+    double l = v3_len(a);
+    return l > 0.0 ? v3(a.x / l, a.y / l, a.z / l) : a;
+}
+
 static inline int v3_finite(lp_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
 #endif
