@@ -1206,8 +1206,11 @@ static void pol_values(rs_worker *w, lp_vec3 o, lp_vec3 d, double *L)
     /* at[k] is now the end of lane k's rays */
     for (int k = 0; k < nl; k++) {
         size_t from = k ? at[k - 1] : 0;
-        L[k] = rs_coherent_power(w->one.r + from, at[k] - from, &w->wavelets, it->coherent,
-                                 it->coherence, it->n_sources, it->lanes[k].lambda);
+        /* a lane without rays sees nothing (w->one.r may not exist yet) */
+        L[k] = at[k] == from ? 0.0
+                             : rs_coherent_power(w->one.r + from, at[k] - from, &w->wavelets,
+                                                 it->coherent, it->coherence, it->n_sources,
+                                                 it->lanes[k].lambda);
     }
 }
 
