@@ -26,6 +26,8 @@ struct rs_bvh {
     int *unbounded;   /* objects tried for every ray, in index order */
     size_t n_unbounded;
     size_t n_objects; /* of the scene it was built on */
+    double (*box)[6]; /* per object: lo, hi (rs_bvh_may_meet) */
+    unsigned char *cull; /* per object: rs_bvh_may_meet tests its box */
 };
 
 typedef struct item {
@@ -220,14 +222,21 @@ int rs_bvh_build(const rs_scene *scene, rs_bvh **out)
     b->obj = calloc(n ? n : 1, sizeof *b->obj);
     b->unbounded = calloc(n ? n : 1, sizeof *b->unbounded);
     b->node = calloc(n ? 2 * n : 1, sizeof *b->node);
-    if (!b->obj || !b->unbounded || !b->node)
+    b->box = calloc(n ? n : 1, sizeof *b->box);
+    b->cull = calloc(n ? n : 1, 1);
+    if (!b->obj || !b->unbounded || !b->node || !b->box || !b->cull)
         goto fail;
     for (size_t i = 0; i < n; i++) {
         lp_vec3 lo, hi;
-        if (!rs_object_bounds(&scene->objects[i], &lo, &hi)) {
+        const rs_object *o = &scene->objects[i];
+        if (!rs_object_bounds(o, &lo, &hi)) {
             b->unbounded[b->n_unbounded++] = (int)i;
             continue;
         }
+        b->cull[i] = o->type == RS_OBJ_LENS || o->type == RS_OBJ_CSG || o->type == RS_OBJ_TORUS ||
+                     o->type == RS_OBJ_CYLINDER || o->type == RS_OBJ_CONE;
+        double *bx = b->box[i];
+        bx[0] = lo.x, bx[1] = lo.y, bx[2] = lo.z, bx[3] = hi.x, bx[4] = hi.y, bx[5] = hi.z;
         item *it = &items[n_items++];
         it->lo[0] = lo.x, it->lo[1] = lo.y, it->lo[2] = lo.z;
         it->hi[0] = hi.x, it->hi[1] = hi.y, it->hi[2] = hi.z;
@@ -253,6 +262,8 @@ void rs_bvh_destroy(rs_bvh *b)
     free(b->node);
     free(b->obj);
     free(b->unbounded);
+    free(b->box);
+    free(b->cull);
     free(b);
 }
 
@@ -266,13 +277,9 @@ size_t rs_bvh_node_count(const rs_bvh *b) { return b ? b->n_nodes : 0; }
 size_t rs_bvh_object_count(const rs_bvh *b) { return b ? b->n_objects : 0; }
 size_t rs_bvh_unbounded_count(const rs_bvh *b) { return b ? b->n_unbounded : 0; }
 
-/* A ray prepared for slab tests. */
-typedef struct slab_ray {
-    double o[3], inv[3];
-    int zero[3]; /* direction component 0: the slab is a containment test */
-} slab_ray;
+typedef rs_slab_ray slab_ray;
 
-static void slab_init(slab_ray *r, lp_vec3 o, lp_vec3 d)
+void rs_slab_ray_init(slab_ray *r, lp_vec3 o, lp_vec3 d)
 {
     double oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
     for (int k = 0; k < 3; k++) {
@@ -282,16 +289,17 @@ static void slab_init(slab_ray *r, lp_vec3 o, lp_vec3 d)
     }
 }
 
-/* Does the segment t in [t0, t1] meet the node's box? */
-static int slab_hit(const slab_ray *r, const bvh_node *nd, double t0, double t1)
+/* Does the segment t in [t0, t1] meet the box lo..hi?  (A direction
+ * component 0 makes that slab a containment test.) */
+static int slab_box(const slab_ray *r, const double *lo, const double *hi, double t0, double t1)
 {
     for (int k = 0; k < 3; k++) {
         if (r->zero[k]) {
-            if (r->o[k] < nd->lo[k] || r->o[k] > nd->hi[k])
+            if (r->o[k] < lo[k] || r->o[k] > hi[k])
                 return 0;
             continue;
         }
-        double a = (nd->lo[k] - r->o[k]) * r->inv[k], b = (nd->hi[k] - r->o[k]) * r->inv[k];
+        double a = (lo[k] - r->o[k]) * r->inv[k], b = (hi[k] - r->o[k]) * r->inv[k];
         if (a > b) {
             double s = a;
             a = b;
@@ -303,6 +311,18 @@ static int slab_hit(const slab_ray *r, const bvh_node *nd, double t0, double t1)
             return 0;
     }
     return 1;
+}
+
+static int slab_hit(const slab_ray *r, const bvh_node *nd, double t0, double t1)
+{
+    return slab_box(r, nd->lo, nd->hi, t0, t1);
+}
+
+int rs_bvh_may_meet(const rs_bvh *b, int i, const slab_ray *r, double t_min, double t_max)
+{
+    if (!b || i < 0 || (size_t)i >= b->n_objects || !b->cull[i])
+        return 1;
+    return slab_box(r, b->box[i], b->box[i] + 3, t_min, t_max);
 }
 
 /* nextafter(x, +infinity), inline for the common finite x > 0. */
@@ -347,7 +367,7 @@ int rs_bvh_intersect(const rs_bvh *b, const rs_scene *scene, lp_vec3 origin, lp_
         if (b->unbounded[u] != skip)
             try_object(scene, b->unbounded[u], origin, dir, t_min, &best, &found);
     if (b->n_nodes > 0) {
-        slab_init(&r, origin, dir);
+        rs_slab_ray_init(&r, origin, dir);
         stack[sp++] = 0;
     }
     while (sp > 0) {
@@ -389,7 +409,7 @@ int rs_bvh_any(const rs_bvh *b, lp_vec3 origin, lp_vec3 dir, double t_min, doubl
         if ((v = fn(ctx, b->unbounded[u])) != 0)
             return v;
     if (b->n_nodes > 0) {
-        slab_init(&r, origin, dir);
+        rs_slab_ray_init(&r, origin, dir);
         stack[sp++] = 0;
     }
     while (sp > 0) {

@@ -52,6 +52,23 @@ int rs_bvh_any(const rs_bvh *bvh, lp_vec3 origin, lp_vec3 dir, double t_min, dou
  * on these very objects and it holds at least RS_BVH_MIN_BOUNDED of them. */
 int rs_bvh_serves(const rs_bvh *bvh, const rs_scene *scene);
 
+/* A ray prepared for box tests: the origin, the inverse direction and
+ * which components of the direction are 0. */
+typedef struct rs_slab_ray {
+    double o[3], inv[3];
+    int zero[3];
+} rs_slab_ray;
+void rs_slab_ray_init(rs_slab_ray *r, lp_vec3 origin, lp_vec3 dir);
+
+/* Whether origin + t dir, t in [t_min, t_max] (r from them, dir unit), may
+ * meet object i of the scene the tree was built on: 0 only when it misses
+ * the object's box, kept for the objects whose own test costs more than a
+ * box's (lenses, CSG objects, tori, cylinders, cones); 1 for the others.
+ * The loops over every object of a small scene ask this first; a hit the
+ * object reports always lies in its box. */
+int rs_bvh_may_meet(const rs_bvh *bvh, int object, const rs_slab_ray *r, double t_min,
+                    double t_max);
+
 /* Number of tree nodes, of unbounded objects (for tests and benchmarks),
  * and of the scene's objects when it was built. */
 size_t rs_bvh_node_count(const rs_bvh *bvh);

@@ -88,7 +88,24 @@ struct rs_integrator {
     double *lane_light;         /* [k * n_lanes + lane]: band_light of light
                                    k in each lane, once per render */
     double *lane_background;    /* per lane: the background's emission */
+    double *lane_xyz;           /* [lane * 3 + c]: what one unit of the lane's
+                                   value adds to the pixel's XYZ (a continuum
+                                   wavelength's CIE value, a line's XYZ) */
 };
+
+/* What a colour is in every lane (band_emission or band_reflectance of
+ * it), kept per worker for the colours met last: a shaded point's
+ * pigment, emission, ambient and mirror colours are few per scene, and
+ * the spectral evaluation of one costs more than the rest of the shading.
+ * One table per use, so that the values of a shaded point's colours stay
+ * in place together. */
+enum { CC_EMISSION, CC_AMBIENT, CC_PIGMENT, CC_MIRROR_MAX, CC_MIRROR_MIN, CC_KINDS };
+#define RS_COLOUR_CACHE 64 /* entries per table, a power of 2 */
+
+typedef struct colour_entry {
+    rs_color c;
+    int used;
+} colour_entry;
 
 typedef struct frame {
     lp_backward *bw;
@@ -116,6 +133,8 @@ struct rs_worker {
     size_t *lane_at;     /* n_lanes + 1: where each lane's rays are in one */
     rs_wavelets wavelets; /* of the band being traced (coherence.h) */
     uint64_t splits;      /* crystal lens hits, for rs_coherence_split */
+    colour_entry cc[CC_KINDS][RS_COLOUR_CACHE];
+    double *cc_val;       /* [(kind * RS_COLOUR_CACHE + entry) * n_lanes + lane] */
 };
 
 /* Source ids: 0 ambient, 1 background, 2 + k light k, 2 + L + i object i. */
@@ -317,6 +336,7 @@ void rs_integrator_destroy(rs_integrator *it)
     rs_lane_classes_destroy(it->classes);
     free(it->lane_light);
     free(it->lane_background);
+    free(it->lane_xyz);
     free(it);
 }
 
@@ -329,7 +349,9 @@ rs_worker *rs_worker_create(const rs_integrator *it)
     w->lane_all = calloc((size_t)it->n_lanes, sizeof *w->lane_all);
     w->lane_value = calloc((size_t)it->n_lanes, sizeof *w->lane_value);
     w->lane_at = calloc((size_t)it->n_lanes + 1, sizeof *w->lane_at);
-    if (!w->lane_all || !w->lane_value || !w->lane_at) {
+    w->cc_val = calloc((size_t)CC_KINDS * RS_COLOUR_CACHE * (size_t)it->n_lanes,
+                       sizeof *w->cc_val);
+    if (!w->lane_all || !w->lane_value || !w->lane_at || !w->cc_val) {
         rs_worker_destroy(w);
         return NULL;
     }
@@ -367,6 +389,7 @@ void rs_worker_destroy(rs_worker *w)
     free(w->lane_all);
     free(w->lane_value);
     free(w->lane_at);
+    free(w->cc_val);
     free(w->pixel.r);
     free(w->pixel.lane);
     free(w->one.r);
@@ -483,14 +506,49 @@ static int make_lane_tables(rs_integrator *it)
     size_t nl = it->scene->n_lights, n = (size_t)it->n_lanes;
     it->lane_light = calloc(nl * n + 1, sizeof *it->lane_light);
     it->lane_background = calloc(n + 1, sizeof *it->lane_background);
-    if (!it->lane_light || !it->lane_background)
+    it->lane_xyz = calloc(3 * n + 1, sizeof *it->lane_xyz);
+    if (!it->lane_light || !it->lane_background || !it->lane_xyz)
         return -1;
     for (size_t k = 0; k < nl; k++)
         for (size_t i = 0; i < n; i++)
             it->lane_light[k * n + i] = band_light_eval(it, &it->lanes[i], (int)k);
     for (size_t i = 0; i < n; i++)
         it->lane_background[i] = band_emission(&it->lanes[i], it->scene->background);
+    for (size_t i = 0; i < n && it->opts.mode != RS_MODE_RGB; i++) {
+        const band *b = &it->lanes[i];
+        if (b->kind == BAND_CONTINUUM) {
+            rs_cmf(b->lambda, &it->lane_xyz[3 * i]);
+        } else {
+            const rs_light *l = &it->scene->lights[b->light];
+            rs_spectrum s = l->spectrum;
+            s.rgb = l->color; /* the tint of the line */
+            rs_spectrum_line_xyz(&s, &it->lane_xyz[3 * i]);
+        }
+    }
     return 0;
+}
+
+/* The values of colour c in every lane for use `kind` (see colour_entry):
+ * band_emission, or band_reflectance for the pigment and mirror colours. */
+static const double *lane_colour(rs_worker *w, int kind, rs_color c)
+{
+    const rs_integrator *it = w->it;
+    uint64_t u[3], h;
+    memcpy(&u[0], &c.r, sizeof u[0]);
+    memcpy(&u[1], &c.g, sizeof u[1]);
+    memcpy(&u[2], &c.b, sizeof u[2]);
+    h = (u[0] * 0x9E3779B97F4A7C15u) ^ (u[1] * 0xC2B2AE3D27D4EB4Fu) ^ (u[2] * 0x165667B19E3779F9u);
+    size_t e = (size_t)(h >> 58) & (RS_COLOUR_CACHE - 1);
+    colour_entry *ce = &w->cc[kind][e];
+    double *v = w->cc_val + ((size_t)kind * RS_COLOUR_CACHE + e) * (size_t)it->n_lanes;
+    if (!ce->used || memcmp(&ce->c, &c, sizeof c) != 0) {
+        int refl = kind == CC_PIGMENT || kind == CC_MIRROR_MAX || kind == CC_MIRROR_MIN;
+        for (int k = 0; k < it->n_lanes; k++)
+            v[k] = refl ? band_reflectance(&it->lanes[k], c) : band_emission(&it->lanes[k], c);
+        ce->c = c;
+        ce->used = 1;
+    }
+    return v;
 }
 
 /* The parity (0 or 1) of floor(v + 1e-10) for any v: fmod is exact at
@@ -595,11 +653,17 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
     sg.dist = dist;
     sg.np = 0;
     int blocked = 0;
-    if (rs_bvh_serves(sc->bvh, sc))
+    if (rs_bvh_serves(sc->bvh, sc)) {
         blocked = rs_bvh_any(sc->bvh, x, d, sg.eps, dist, shadow_meets, &sg);
-    else
+    } else {
+        rs_slab_ray r;
+        int boxes = sc->bvh && rs_bvh_object_count(sc->bvh) == sc->n_objects;
+        if (boxes)
+            rs_slab_ray_init(&r, x, d);
         for (size_t i = 0; i < sc->n_objects && !blocked; i++)
-            blocked = shadow_meets(&sg, (int)i);
+            if (!boxes || rs_bvh_may_meet(sc->bvh, (int)i, &r, sg.eps, dist))
+                blocked = shadow_meets(&sg, (int)i);
+    }
     if (blocked)
         return 0.0;
     const size_t *pol = sg.pol;
@@ -671,16 +735,22 @@ typedef struct shade_point {
     rs_color pig;
     lp_vec3 x;
     double *cb, *s, *reach; /* per light */
+    /* per lane (lane_colour): valid until the worker shades another point */
+    const double *emission, *ambient, *pigment;
 } shade_point;
 
-static void shade_begin(const rs_integrator *it, const rs_hit *h, lp_vec3 dir, frame *fr,
-                        shade_point *sp)
+static void shade_begin(rs_worker *w, const rs_hit *h, lp_vec3 dir, frame *fr, shade_point *sp)
 {
+    const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
     const rs_object *o = h->surface;
     const rs_finish *f = &o->finish;
     sp->h = h;
     sp->pig = pigment_at(&o->pigment, h->point);
+    sp->emission = lane_colour(w, CC_EMISSION, mul(sp->pig, f->emission));
+    sp->ambient =
+        lane_colour(w, CC_AMBIENT, mul(sp->pig, mul(f->ambient, sc->settings.ambient_light)));
+    sp->pigment = lane_colour(w, CC_PIGMENT, sp->pig);
     sp->x = v3_madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(v3_dot(h->point, h->point))));
     sp->cb = fr->cb;
     sp->s = fr->hs;
@@ -709,16 +779,16 @@ static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_
     const rs_hit *h = sp->h;
     const rs_object *o = h->surface;
     const rs_finish *f = &o->finish;
-    rs_color pig = sp->pig;
-    double e = band_emission(b, mul(pig, f->emission));
+    size_t lane = (size_t)(b - it->lanes);
+    double e = sp->emission[lane];
     if (e != 0.0)
         emit(ctx, src_object(it, h->object), e);
-    double a = band_emission(b, mul(pig, mul(f->ambient, sc->settings.ambient_light)));
+    double a = sp->ambient[lane];
     if (a != 0.0)
         emit(ctx, 0, a);
     if (sc->n_lights == 0)
         return;
-    double rho = band_reflectance(b, pig) * f->diffuse;
+    double rho = sp->pigment[lane] * f->diffuse;
     if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
         return;
     for (size_t k = 0; k < sc->n_lights; k++) {
@@ -741,13 +811,14 @@ static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_
 /* The mirror reflectivity of a surface in this band for a ray along d
  * (0: none): `reflection` as min + (max - min) F, F the unpolarized Fresnel
  * reflectance into the object's ior with fresnel on, else max. */
-static double reflectivity(const band *b, const rs_object *o, const rs_hit *h, lp_vec3 d)
+static double reflectivity(rs_worker *w, int lane, const rs_object *o, const rs_hit *h,
+                           lp_vec3 d)
 {
     const rs_finish *f = &o->finish;
-    double rmax = band_reflectance(b, f->reflection_max);
+    double rmax = lane_colour(w, CC_MIRROR_MAX, f->reflection_max)[lane];
     if (!f->fresnel)
         return rmax;
-    double rmin = band_reflectance(b, f->reflection_min);
+    double rmin = lane_colour(w, CC_MIRROR_MIN, f->reflection_min)[lane];
     double ci = -v3_dot(d, h->normal), n = o->ior;
     double F = 0.0;
     if (ci > 1.0)
@@ -848,7 +919,7 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     if (!fr)
         return;
     shade_point sp;
-    shade_begin(it, &h, d, fr, &sp);
+    shade_begin(w, &h, d, fr, &sp);
     for (int k = 0; k < n; k++)
         shade(it, &it->lanes[lane[k]], &sp, emit_sum, &out[k]);
     if (!has_reflection(&ob->finish) || level >= it->max_level || f + 1 >= RS_MAX_FRAMES)
@@ -858,7 +929,7 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     /* The mirror ray, shared by the lanes of equal reflectivity (they
      * carry the same weight on). */
     for (int k = 0; k < n; k++) {
-        double r = reflectivity(&it->lanes[lane[k]], ob, &h, d);
+        double r = reflectivity(w, lane[k], ob, &h, d);
         fr->val[k] = r;
         fr->done[k] = !(r > 0.0 && weight * r >= it->cutoff);
     }
@@ -949,7 +1020,7 @@ static void mirror_pol(rs_worker *w, const int *lane, int n, const rs_object *ob
     lp_vec3 rd = v3_unit_or_self(v3_madd(d, nv, -2.0 * v3_dot(d, nv)));
     lp_vec3 x = v3_madd(h->point, nv, 1e-9 * (1.0 + sqrt(v3_dot(h->point, h->point))));
     for (int k = 0; k < n; k++) {
-        double r = reflectivity(&it->lanes[lane[k]], ob, h, d);
+        double r = reflectivity(w, lane[k], ob, h, d);
         fr->val[k] = r;
         fr->done[k] = !(r > 0.0) || weight * r < it->cutoff;
     }
@@ -1165,7 +1236,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
     emit_ctx e = emit_ctx_make(out, d, record_wavelet(w, o, d, &h));
     if (e.wavelet >= 0) {
         shade_point sp;
-        shade_begin(it, &h, d, fr, &sp);
+        shade_begin(w, &h, d, fr, &sp);
         for (int k = 0; k < n; k++) {
             e.lane = lane[k];
             shade(it, &it->lanes[lane[k]], &sp, emit_halves, &e);
@@ -1229,24 +1300,18 @@ static void ray_colour(const rs_integrator *it, rs_worker *w, lp_vec3 o, lp_vec3
         *out = (rs_color){L[0], L[1], L[2]};
         return;
     }
-    double xyz[3] = {0, 0, 0}, lines[3] = {0, 0, 0}, cmf[3];
+    double xyz[3] = {0, 0, 0}, lines[3] = {0, 0, 0};
     int n = it->opts.wavelengths;
     double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
     for (int k = 0; k < n; k++) {
-        rs_cmf(it->lanes[k].lambda, cmf);
+        const double *cmf = &it->lane_xyz[3 * k];
         for (int c = 0; c < 3; c++)
             xyz[c] += L[k] * cmf[c] * dl;
     }
     /* Lines are exact deltas: no quadrature, no correction. */
-    for (int k = n; k < it->n_lanes; k++) {
-        const rs_light *l = &it->scene->lights[it->lanes[k].light];
-        double lx[3];
-        rs_spectrum s = l->spectrum;
-        s.rgb = l->color; /* the tint of the line */
-        rs_spectrum_line_xyz(&s, lx);
+    for (int k = n; k < it->n_lanes; k++)
         for (int c = 0; c < 3; c++)
-            lines[c] += L[k] * lx[c];
-    }
+            lines[c] += L[k] * it->lane_xyz[3 * k + c];
     rs_color raw, rl;
     rs_xyz_to_linear_srgb(xyz, &raw);
     rs_xyz_to_linear_srgb(lines, &rl);

@@ -193,10 +193,14 @@ int rs_scene_intersect(const rs_scene *scene, lp_vec3 origin, lp_vec3 dir, doubl
 {
     int found = 0;
     rs_hit h;
+    rs_slab_ray r;
     if (rs_bvh_serves(scene->bvh, scene))
         return rs_bvh_intersect(scene->bvh, scene, origin, dir, t_min, t_max, skip, hit);
+    int boxes = scene->bvh && rs_bvh_object_count(scene->bvh) == scene->n_objects;
+    if (boxes)
+        rs_slab_ray_init(&r, origin, dir);
     for (size_t i = 0; i < scene->n_objects; i++) {
-        if ((int)i == skip)
+        if ((int)i == skip || (boxes && !rs_bvh_may_meet(scene->bvh, (int)i, &r, t_min, t_max)))
             continue;
         if (rs_object_intersect(&scene->objects[i], origin, dir, t_min, t_max, &h)) {
             h.object = (int)i;
