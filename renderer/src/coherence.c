@@ -78,7 +78,7 @@ static double wavelet_difference(const rs_wavelet *a, const rs_wavelet *b, int *
     return -v3_dot(u, dab) / lu;
 }
 
-double rs_coherent_power(const lp_ray *r, size_t n, const rs_wavelets *t,
+double rs_coherent_power(const lp_ray *const *r, const double *I, size_t n, const rs_wavelets *t,
                          const unsigned char *coherent, const double *coherence,
                          int n_sources, double lambda_nm)
 {
@@ -86,18 +86,18 @@ double rs_coherent_power(const lp_ray *r, size_t n, const rs_wavelets *t,
     double k0 = 2.0 * RS_COH_PI / (lambda_nm * 1e-6);
 
     for (size_t i = 0; i < n; i++) {
-        const lp_ray *a = &r[i];
-        total += a->intensity;
+        const lp_ray *a = r[i];
+        total += I[i];
         uint64_t ca = a->ch & RS_COH_LOW, src = (ca & RS_COH_SOURCE) / 2, ia = a->ch >> 32;
         int split = (ca & RS_COH_SPLIT) != 0;
-        if (src >= (uint64_t)n_sources || !(coherent[src] || split) || a->intensity == 0.0 ||
+        if (src >= (uint64_t)n_sources || !(coherent[src] || split) || I[i] == 0.0 ||
             ia >= t->n)
             continue;
         double lc = coherent[src] ? coherence[src] : 0.0;
         for (size_t j = i + 1; j < n; j++) {
-            const lp_ray *b = &r[j];
+            const lp_ray *b = r[j];
             uint64_t ib = b->ch >> 32;
-            if ((b->ch & RS_COH_LOW) != ca || b->intensity == 0.0 || ib >= t->n)
+            if ((b->ch & RS_COH_LOW) != ca || I[j] == 0.0 || ib >= t->n)
                 continue;
             int ok;
             double dop = a->op - b->op + wavelet_difference(&t->w[ia], &t->w[ib], &ok);
@@ -108,7 +108,7 @@ double rs_coherent_power(const lp_ray *r, size_t n, const rs_wavelets *t,
                 continue;
             double dphi = k0 * dop - RS_COH_PI * (a->kphi - b->kphi) + (a->phase - b->phase);
             double vv = v3_dot(a->vp, b->vp);
-            total += 2.0 * gamma * sqrt(a->intensity * b->intensity) * vv * cos(dphi);
+            total += 2.0 * gamma * sqrt(I[i] * I[j]) * vv * cos(dphi);
         }
     }
     return total > 0.0 ? total : 0.0;

@@ -76,16 +76,17 @@ uint64_t rs_coherence_ch(long index, int source, int half);
 #define RS_COHERENCE_MAX_SOURCES 32768
 uint64_t rs_coherence_split(uint64_t ch, uint64_t hit, int depth, int transmit);
 
-/* What the pixel receives from rays r[0..n) of one wavelength (nm, in
- * air): rays of different channels, or of a channel that is not coherent,
- * add as intensities; two rays of one coherent channel (coherent[src]) add
+/* What the pixel receives from rays *r[0..n) of one wavelength (nm, in
+ * air), ray i of intensity I[i] (its own intensity field unused): rays
+ * of different channels, or of a channel that is not coherent, add as
+ * intensities; two rays of one coherent channel (coherent[src]) add
  * as amplitudes sqrt(I) vp exp(i(2 pi op/lambda - pi kphi + phase)) with
  * their path difference D taken as above and the visibility
  * gamma = exp(-(D/L)^2) of the source's coherence length L = coherence[src]
  * (gamma = 1 for L = 0: infinite):
  *     P = sum_i I_i + sum_{i<j} 2 gamma_ij sqrt(I_i I_j) (vp_i.vp_j) cos(phi_i - phi_j).
  * Negative totals (rounding) are returned as 0. */
-double rs_coherent_power(const lp_ray *r, size_t n, const rs_wavelets *t,
+double rs_coherent_power(const lp_ray *const *r, const double *I, size_t n, const rs_wavelets *t,
                          const unsigned char *coherent, const double *coherence,
                          int n_sources, double lambda_nm);
 

@@ -59,12 +59,21 @@ typedef struct band {
     int channel;    /* BAND_RGB */
 } band;
 
-/* Rays of the polarized mode; lane[i] is the lane (index of it->lanes)
- * ray i belongs to: a packet's bundle holds every lane's rays. */
+/* Rays of the polarized mode.  A packet's bundle holds every lane's rays:
+ * ray i belongs to lane lane[i] (an index of it->lanes) when that is >= 0;
+ * otherwise it is a shared ray, the same light in several lanes of equal
+ * optics that differ only in its intensity: vector s = -1 - lane[i] gives
+ * per lane whether the lane has the ray (has[s * nl + lane]) and its
+ * intensity there (I[s * nl + lane]); r[i].intensity is that of its first
+ * lane.  Each lane's rays, in bundle order, are those tracing the lane
+ * alone would give, in that order. */
 typedef struct bundle {
     lp_ray *r;
     int *lane;
     size_t n, cap;
+    double *I;
+    unsigned char *has;
+    size_t ns, scap; /* shared vectors used, allocated */
 } bundle;
 
 struct rs_integrator {
@@ -88,6 +97,8 @@ struct rs_integrator {
     double *lane_light;         /* [k * n_lanes + lane]: band_light of light
                                    k in each lane, once per render */
     double *lane_background;    /* per lane: the background's emission */
+    int interferes;             /* some rays may add as amplitudes: a coherent
+                                   source or a crystal lens */
     double *lane_xyz;           /* [lane * 3 + c]: what one unit of the lane's
                                    value adds to the pixel's XYZ (a continuum
                                    wavelength's CIE value, a line's XYZ) */
@@ -121,6 +132,9 @@ typedef struct frame {
     unsigned char *done;
     double *reach;  /* per light: light_reach memo of one shaded point */
     double *cb, *hs; /* per light: shade_point's cosine terms and highlights */
+    /* emit_collect: per source slot (object, ambient, lights) and lane */
+    double *rad;
+    unsigned char *got;
 } frame;
 
 struct rs_worker {
@@ -129,7 +143,9 @@ struct rs_worker {
     int *lane_all;       /* 0 .. n_lanes - 1 */
     double *lane_value;  /* a pixel's value per lane */
     bundle pixel;
-    bundle one;          /* pixel's rays sorted by lane */
+    const lp_ray **one;  /* pixel's rays by lane (pol_values) */
+    double *one_i;       /* and their intensities in that lane */
+    size_t one_cap;
     size_t *lane_at;     /* n_lanes + 1: where each lane's rays are in one */
     rs_wavelets wavelets; /* of the band being traced (coherence.h) */
     uint64_t splits;      /* crystal lens hits, for rs_coherence_split */
@@ -315,6 +331,10 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
             it->coherent[src_light(it, (int)k)] = 1;
             it->coherence[src_light(it, (int)k)] = scene->lights[k].coherence_length;
         }
+    for (int s = 0; s < it->n_sources; s++)
+        it->interferes |= it->coherent[s];
+    for (size_t i = 0; i < scene->n_objects; i++)
+        it->interferes |= scene->objects[i].type == RS_OBJ_LENS && scene->objects[i].u.lens.desc.uniaxial;
     if (make_lanes(it) != 0 || make_lane_tables(it) != 0) {
         rs_integrator_destroy(it);
         snprintf(msg, msg_size, "out of memory");
@@ -370,6 +390,10 @@ void rs_worker_destroy(rs_worker *w)
         lp_backward_destroy(w->frames[f]->bw);
         free(w->frames[f]->child.r);
         free(w->frames[f]->child.lane);
+        free(w->frames[f]->child.I);
+        free(w->frames[f]->child.has);
+        free(w->frames[f]->rad);
+        free(w->frames[f]->got);
         free(w->frames[f]->g_of);
         free(w->frames[f]->g_ray);
         free(w->frames[f]->g_start);
@@ -392,8 +416,10 @@ void rs_worker_destroy(rs_worker *w)
     free(w->cc_val);
     free(w->pixel.r);
     free(w->pixel.lane);
-    free(w->one.r);
-    free(w->one.lane);
+    free(w->pixel.I);
+    free(w->pixel.has);
+    free(w->one);
+    free(w->one_i);
     rs_wavelets_free(&w->wavelets);
     free(w);
 }
@@ -416,8 +442,10 @@ static frame *get_frame(rs_worker *w, int f)
         fr->bad = calloc(n, 1);
         fr->cb = calloc(w->it->scene->n_lights + 1, sizeof *fr->cb);
         fr->hs = calloc(w->it->scene->n_lights + 1, sizeof *fr->hs);
+        fr->rad = calloc((w->it->scene->n_lights + 2) * n, sizeof *fr->rad);
+        fr->got = calloc((w->it->scene->n_lights + 2) * n, 1);
         if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach || !fr->bad ||
-            !fr->cb || !fr->hs ||
+            !fr->cb || !fr->hs || !fr->rad || !fr->got ||
             lp_backward_create(&fr->bw, NULL) != LP_OK) {
             free(fr->lane);
             free(fr->pos);
@@ -428,6 +456,8 @@ static frame *get_frame(rs_worker *w, int f)
             free(fr->bad);
             free(fr->cb);
             free(fr->hs);
+            free(fr->rad);
+            free(fr->got);
             free(fr);
             return NULL;
         }
@@ -454,6 +484,64 @@ static lp_ray *bundle_push(bundle *b, int lane)
     }
     b->lane[b->n] = lane;
     return &b->r[b->n++];
+}
+
+/* A new shared ray at the end of b, no lane having it yet; its vector in
+ * *I and *has (nl entries each).  NULL when out of memory. */
+static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char **has)
+{
+    if (b->ns == b->scap) {
+        size_t cap = b->scap ? 2 * b->scap : 8;
+        double *pi = realloc(b->I, cap * (size_t)nl * sizeof *pi);
+        if (!pi)
+            return NULL;
+        b->I = pi;
+        unsigned char *ph = realloc(b->has, cap * (size_t)nl);
+        if (!ph)
+            return NULL;
+        b->has = ph;
+        b->scap = cap;
+    }
+    size_t s = b->ns;
+    lp_ray *r = bundle_push(b, -1 - (int)s);
+    if (!r)
+        return NULL;
+    b->ns++;
+    *I = b->I + s * (size_t)nl;
+    *has = b->has + s * (size_t)nl;
+    memset(*has, 0, (size_t)nl);
+    return r;
+}
+
+static void bundle_clear(bundle *b)
+{
+    b->n = 0;
+    b->ns = 0;
+}
+
+/* Append ray i of `from` to `to` (its lane, or a copy of its shared
+ * vector), every intensity multiplied by scale; NULL when out of memory. */
+static lp_ray *bundle_copy(bundle *to, const bundle *from, size_t i, double scale, int nl)
+{
+    int l = from->lane[i];
+    lp_ray *p;
+    if (l >= 0) {
+        p = bundle_push(to, l);
+    } else {
+        double *I;
+        unsigned char *has;
+        size_t s = (size_t)(-1 - l);
+        p = bundle_push_shared(to, nl, &I, &has);
+        if (p)
+            for (int k = 0; k < nl; k++)
+                if ((has[k] = from->has[s * (size_t)nl + (size_t)k]) != 0)
+                    I[k] = from->I[s * (size_t)nl + (size_t)k] * scale;
+    }
+    if (!p)
+        return NULL;
+    *p = from->r[i];
+    p->intensity *= scale;
+    return p;
 }
 
 /* ---- small colour helpers ---- */
@@ -855,6 +943,40 @@ static void emit_sum(void *ctx, int source, double radiance)
     *(double *)ctx += radiance;
 }
 
+/* The arguments of a lens hit's trace at this level and weight; 0 when
+ * no level is left for it. */
+static int lens_args(const rs_integrator *it, int level, double weight, lp_trace_args *a)
+{
+    int dT = it->max_level - level;
+    if (dT < 1)
+        return 0;
+    lp_trace_args_init(a);
+    a->mode = lens_mode(it);
+    a->max_depth = dT < LP_MAX_DEPTH ? dT : LP_MAX_DEPTH;
+    a->min_weight = weight > 0.0 ? it->cutoff / weight : INFINITY;
+    return 1;
+}
+
+/* The next sub-packet of lane[0..n) at lens `object` (lanes of equal
+ * optics there, rs_packet_next) whose backward trace along (o, d) builds:
+ * its lanes in fr->lane, their positions in lane[] in fr->pos, the build
+ * in fr->bw.  Returns how many lanes, 0 when every lane is done (fr->done
+ * cleared by the caller first).  A sub-packet whose build fails sees
+ * nothing. */
+static int lens_next(const rs_integrator *it, frame *fr, const rs_object *ob, int object,
+                     const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a)
+{
+    int m;
+    while ((m = rs_packet_next(it->classes, object, lane, n, fr->done, fr->pos)) > 0) {
+        for (int k = 0; k < m; k++)
+            fr->lane[k] = lane[fr->pos[k]];
+        if (lp_backward_build(fr->bw, ob->lens, o, d, it->lanes[fr->lane[0]].lambda, a, NULL) ==
+            LP_OK)
+            return m;
+    }
+    return 0;
+}
+
 /* The radiance of every lane of lane[0..n) (indices of it->lanes) seen
  * along the ray, into out[0..n).  The lanes travel as one spectral packet
  * (packet.h) and split at a lens where their optics differ; each lane's
@@ -875,22 +997,13 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
         out[k] = 0.0;
     const rs_object *ob = h.surface;
     if (ob->type == RS_OBJ_LENS) {
-        int dT = it->max_level - level, m;
+        int m;
         frame *fr = get_frame(w, f);
-        if (dT < 1 || !fr)
-            return;
         lp_trace_args a;
-        lp_trace_args_init(&a);
-        a.mode = lens_mode(it);
-        a.max_depth = dT < LP_MAX_DEPTH ? dT : LP_MAX_DEPTH;
-        a.min_weight = weight > 0.0 ? it->cutoff / weight : INFINITY;
+        if (!fr || !lens_args(it, level, weight, &a))
+            return;
         memset(fr->done, 0, (size_t)n);
-        while ((m = rs_packet_next(it->classes, h.object, lane, n, fr->done, fr->pos)) > 0) {
-            for (int k = 0; k < m; k++)
-                fr->lane[k] = lane[fr->pos[k]];
-            if (lp_backward_build(fr->bw, ob->lens, o, d, it->lanes[fr->lane[0]].lambda, &a,
-                                  NULL) != LP_OK)
-                continue;
+        while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             for (int k = 0; k < m; k++)
@@ -972,7 +1085,17 @@ static emit_ctx emit_ctx_make(bundle *out, lp_vec3 d, long wavelet)
     return e;
 }
 
-/* Natural light of one source as two orthogonal incoherent halves. */
+/* One half of natural light of a source: the ray, its intensity unset. */
+static void half_ray(const emit_ctx *e, int source, int half, lp_ray *r)
+{
+    memset(r, 0, sizeof *r);
+    r->vp = half ? e->v2 : e->v1;
+    r->op = 0.0;
+    r->ch = rs_coherence_ch(e->wavelet, source, half);
+}
+
+/* Natural light of one source as two orthogonal incoherent halves, in
+ * lane e->lane. */
 static void emit_halves(void *ctx, int source, double radiance)
 {
     emit_ctx *e = ctx;
@@ -980,11 +1103,63 @@ static void emit_halves(void *ctx, int source, double radiance)
         lp_ray *r = bundle_push(e->out, e->lane);
         if (!r)
             return;
-        memset(r, 0, sizeof *r);
+        half_ray(e, source, half, r);
         r->intensity = 0.5 * radiance;
-        r->vp = half ? e->v2 : e->v1;
-        r->op = 0.0;
-        r->ch = rs_coherence_ch(e->wavelet, source, half);
+    }
+}
+
+/* What the lanes of a packet emit, gathered per source slot (0: the
+ * object's emission or the background, 1: ambient, 2 + k: light k, the
+ * order shade() emits in) and lane, to be sent as shared rays (emit_shared). */
+typedef struct collect_ctx {
+    const rs_integrator *it;
+    frame *fr;
+    int lane;
+} collect_ctx;
+
+static void emit_collect(void *ctx, int source, double radiance)
+{
+    collect_ctx *c = ctx;
+    int nl = c->it->n_lanes, slot;
+    int n_lights = (int)c->it->scene->n_lights;
+    slot = source == 0 ? 1 : source == 1 || source >= 2 + n_lights ? 0 : source;
+    c->fr->rad[(size_t)slot * (size_t)nl + (size_t)c->lane] = radiance;
+    c->fr->got[(size_t)slot * (size_t)nl + (size_t)c->lane] = 1;
+}
+
+/* The halves of every source slot some lane of lane[0..n) emitted
+ * (fr->rad, fr->got; cleared here), as shared rays: slot by slot, each
+ * lane's rays in the order emit_halves would give them. */
+static void emit_shared(const rs_integrator *it, frame *fr, const int *lane, int n, int source0,
+                        const emit_ctx *e)
+{
+    int nl = it->n_lanes, n_slots = (int)it->scene->n_lights + 2;
+    for (int slot = 0; slot < n_slots; slot++) {
+        const double *rad = fr->rad + (size_t)slot * (size_t)nl;
+        unsigned char *got = fr->got + (size_t)slot * (size_t)nl;
+        int first = -1;
+        for (int k = 0; k < n && first < 0; k++)
+            if (got[lane[k]])
+                first = lane[k];
+        if (first < 0)
+            continue;
+        int source = slot == 0 ? source0 : slot == 1 ? 0 : slot; /* 2 + k: light k */
+        for (int half = 0; half < 2; half++) {
+            double *I;
+            unsigned char *has;
+            lp_ray *r = bundle_push_shared(e->out, nl, &I, &has);
+            if (!r)
+                break;
+            half_ray(e, source, half, r);
+            r->intensity = 0.5 * rad[first];
+            for (int k = 0; k < n; k++)
+                if (got[lane[k]]) {
+                    has[lane[k]] = 1;
+                    I[lane[k]] = 0.5 * rad[lane[k]];
+                }
+        }
+        for (int k = 0; k < n; k++)
+            got[lane[k]] = 0;
     }
 }
 
@@ -1034,14 +1209,12 @@ static void mirror_pol(rs_worker *w, const int *lane, int n, const rs_object *ob
                 fr->done[j] = 1;
                 fr->lane[m++] = lane[j];
             }
-        fr->child.n = 0;
+        bundle_clear(&fr->child);
         trace_pol(w, fr->lane, m, x, rd, level + 1, weight * r, -1, f + 1, &fr->child);
         for (size_t i = 0; i < fr->child.n; i++) {
-            lp_ray *p = bundle_push(out, fr->child.lane[i]);
+            lp_ray *p = bundle_copy(out, &fr->child, i, r, it->n_lanes);
             if (!p)
                 return;
-            *p = fr->child.r[i];
-            p->intensity *= r;
             p->vp = v3_madd(p->vp, nv, -2.0 * v3_dot(p->vp, nv));
             p->kphi += 1;
             p->op += h->t;
@@ -1060,19 +1233,41 @@ static int same_but_intensity(const lp_ray *a, const lp_ray *b)
            a->origin.z == b->origin.z && a->intensity > 0.0 && b->intensity > 0.0;
 }
 
+/* Runs BODY for every lane LANE that ray i of bundle b has, with INT its
+ * intensity in that lane. */
+#define FOR_LANES(b, i, nl, LANE, INT, BODY)                                            \
+    do {                                                                                \
+        int l_ = (b)->lane[i];                                                          \
+        if (l_ >= 0) {                                                                  \
+            int LANE = l_;                                                              \
+            double INT = (b)->r[i].intensity;                                           \
+            (void)INT;                                                                  \
+            BODY;                                                                       \
+        } else {                                                                        \
+            size_t s_ = (size_t)(-1 - l_) * (size_t)(nl);                               \
+            for (int LANE = 0; LANE < (nl); LANE++)                                     \
+                if ((b)->has[s_ + (size_t)LANE]) {                                      \
+                    double INT = (b)->I[s_ + (size_t)LANE];                             \
+                    (void)INT;                                                          \
+                    BODY;                                                               \
+                }                                                                       \
+        }                                                                               \
+    } while (0)
+
 /* Gather the rays of fr->child (lanes of equal optics at this lens) along
- * query j, appending the outputs to out, each tagged with its ray's lane.
- * Rays of different lanes that differ only in intensity (the same light
- * seen in several wavelengths of equal optics) form a group gathered once:
- * a gather is linear in the intensity, so the others' outputs are the
- * first's scaled by their intensity ratio (a gather of their own gives the
- * same to rounding).  A lane one of whose rays fails to gather gets nothing
- * from this query, as a gather of its rays alone would give.  Returns -1
- * when out of memory. */
-static int gather_shared(frame *fr, size_t j, int split, uint64_t hit, const lp_query *q,
-                         bundle *out)
+ * query j, appending the outputs to out, each with its ray's lanes.
+ * Rays that differ only in intensity (a shared ray's lanes, and rays of
+ * different lanes that carry the same light) form a group gathered once:
+ * a gather is linear in the intensity, so each lane's outputs are the
+ * group's first ray's scaled by their intensity ratio (a gather of their
+ * own gives the same to rounding).  A lane one of whose rays fails to
+ * gather gets nothing from this query, as a gather of its rays alone
+ * would give.  Returns -1 when out of memory. */
+static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, uint64_t hit,
+                         const lp_query *q, bundle *out)
 {
     const bundle *c = &fr->child;
+    int nl = w->it->n_lanes;
     size_t n = c->n, n_g = 0;
     if (n > fr->g_cap) {
         size_t **arr[4] = {&fr->g_of, &fr->g_ray, &fr->g_start, &fr->g_count};
@@ -1107,33 +1302,62 @@ static int gather_shared(frame *fr, size_t j, int split, uint64_t hit, const lp_
     }
     for (size_t i = 0; i < n; i++)
         if (fr->g_count[fr->g_of[i]] == SIZE_MAX)
-            fr->bad[c->lane[i]] = 1;
+            FOR_LANES(c, i, nl, k, I, fr->bad[k] = 1);
     for (size_t i = 0; i < n; i++) {
         size_t g = fr->g_of[i];
-        if (fr->bad[c->lane[i]])
-            continue;
-        double I = c->r[i].intensity, I0 = c->r[fr->g_ray[g]].intensity;
-        double scale = I == I0 ? 1.0 : I / I0;
+        double I0 = c->r[fr->g_ray[g]].intensity;
         for (size_t t = fr->g_start[g]; t < fr->g_start[g] + fr->g_count[g]; t++) {
-            lp_ray *r = bundle_push(out, c->lane[i]);
-            if (!r)
-                return -1;
-            *r = fr->res.rays[t].ray;
-            if (scale != 1.0)
-                r->intensity *= scale;
+            const lp_ray *gr = &fr->res.rays[t].ray;
+            lp_ray *r = NULL;
+            if (c->lane[i] >= 0) {
+                if (fr->bad[c->lane[i]])
+                    break;
+                double I = c->r[i].intensity;
+                double scale = I == I0 ? 1.0 : I / I0;
+                if (!(r = bundle_push(out, c->lane[i])))
+                    return -1;
+                *r = *gr;
+                if (scale != 1.0)
+                    r->intensity *= scale;
+            } else {
+                double *Io;
+                unsigned char *has;
+                int first = -1;
+                lp_ray ray = *gr;
+                size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
+                if (!(r = bundle_push_shared(out, nl, &Io, &has)))
+                    return -1;
+                for (int k = 0; k < nl; k++) {
+                    if (!c->has[s + (size_t)k] || fr->bad[k])
+                        continue;
+                    double I = c->I[s + (size_t)k];
+                    double scale = I == I0 ? 1.0 : I / I0;
+                    has[k] = 1;
+                    Io[k] = scale != 1.0 ? gr->intensity * scale : gr->intensity;
+                    if (first < 0)
+                        first = k;
+                }
+                if (first < 0) { /* every lane failed: no ray */
+                    out->n--;
+                    out->ns--;
+                    break;
+                }
+                ray.intensity = Io[first];
+                *r = ray;
+            }
             if (split)
                 r->ch = rs_coherence_split(r->ch, hit, q[j].depth, q[j].kind != LP_KIND_REFLECT);
         }
     }
     for (size_t i = 0; i < n; i++)
-        fr->bad[c->lane[i]] = 0;
+        FOR_LANES(c, i, nl, k, I, fr->bad[k] = 0);
     return 0;
 }
 
-/* The bundles of lanes lane[0..n) seen along the ray, appended to out,
- * each ray tagged with its lane.  The lanes travel as one packet and
- * split at a lens where their optics differ, as in trace_scalar; the rays
- * of one lane are those, in the same order, that tracing it alone gives. */
+/* The bundles of lanes lane[0..n) seen along the ray, appended to out.
+ * The lanes travel as one packet and split at a lens where their optics
+ * differ, as in trace_scalar; the rays of one lane are those, in the same
+ * order, that tracing it alone gives. */
 static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
                       double weight, int skip, int f, bundle *out)
 {
@@ -1144,15 +1368,23 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
 
     if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
         emit_ctx e = emit_ctx_make(out, d, -1);
+        frame *fr = n > 1 ? get_frame(w, f) : NULL;
         for (int k = 0; k < n; k++) {
             double L = it->lane_background[lane[k]];
             if (L == 0.0)
                 continue;
             if (e.wavelet < 0 && (e.wavelet = record_wavelet(w, o, d, NULL)) < 0)
                 return;
-            e.lane = lane[k];
-            emit_halves(&e, 1, L);
+            if (fr) {
+                collect_ctx cc = {it, fr, lane[k]};
+                emit_collect(&cc, 1, L);
+            } else {
+                e.lane = lane[k];
+                emit_halves(&e, 1, L);
+            }
         }
+        if (fr && e.wavelet >= 0)
+            emit_shared(it, fr, lane, n, 1, &e);
         return;
     }
     const rs_object *ob = h.surface;
@@ -1161,33 +1393,24 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
         return;
 
     if (ob->type == RS_OBJ_LENS) {
-        int dT = it->max_level - level, m;
-        if (dT < 1)
-            return;
+        int m;
         lp_trace_args a;
-        lp_trace_args_init(&a);
-        a.mode = LP_MODE_POLARIZED;
-        a.max_depth = dT < LP_MAX_DEPTH ? dT : LP_MAX_DEPTH;
-        a.min_weight = weight > 0.0 ? it->cutoff / weight : INFINITY;
+        if (!lens_args(it, level, weight, &a))
+            return;
         int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
         memset(fr->done, 0, (size_t)n);
-        while ((m = rs_packet_next(it->classes, h.object, lane, n, fr->done, fr->pos)) > 0) {
-            for (int k = 0; k < m; k++)
-                fr->lane[k] = lane[fr->pos[k]];
-            if (lp_backward_build(fr->bw, ob->lens, o, d, it->lanes[fr->lane[0]].lambda, &a,
-                                  NULL) != LP_OK)
-                continue;
+        while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             uint64_t hit = ++w->splits;
             for (size_t j = 0; j < nq; j++) {
-                fr->child.n = 0;
+                bundle_clear(&fr->child);
                 trace_pol(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
                           weight * q[j].bound, -1, f + 1, &fr->child);
                 if (fr->child.n == 0)
                     continue;
                 if (m > 1) {
-                    if (gather_shared(fr, j, split, hit, q, out) != 0)
+                    if (gather_shared(w, fr, j, split, hit, q, out) != 0)
                         return;
                     continue;
                 }
@@ -1212,23 +1435,20 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
     if (ob->type == RS_OBJ_POLARIZER) {
         if (f + 1 >= RS_MAX_FRAMES)
             return;
-        fr->child.n = 0;
+        bundle_clear(&fr->child);
         trace_pol(w, lane, n, h.point, d, level, weight, h.object, f + 1, &fr->child);
         lp_vec3 ax = ob->u.polarizer.axis;
         ax = v3_unit_or_self(v3_madd(ax, d, -v3_dot(ax, d)));
         for (size_t i = 0; i < fr->child.n; i++) {
-            lp_ray r = fr->child.r[i];
-            double c = v3_dot(r.vp, ax);
+            double c = v3_dot(fr->child.r[i].vp, ax);
             if (c == 0.0)
                 continue;
-            r.intensity *= c * c;
-            r.vp = ax;
-            if (c < 0.0)
-                r.kphi += 1; /* the field now points along -axis */
-            lp_ray *p = bundle_push(out, fr->child.lane[i]);
+            lp_ray *p = bundle_copy(out, &fr->child, i, c * c, it->n_lanes);
             if (!p)
                 return;
-            *p = r;
+            p->vp = ax;
+            if (c < 0.0)
+                p->kphi += 1; /* the field now points along -axis */
         }
         shift_op(out, start, h.t);
         return;
@@ -1237,9 +1457,15 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
     if (e.wavelet >= 0) {
         shade_point sp;
         shade_begin(w, &h, d, fr, &sp);
-        for (int k = 0; k < n; k++) {
-            e.lane = lane[k];
-            shade(it, &it->lanes[lane[k]], &sp, emit_halves, &e);
+        if (n == 1) {
+            e.lane = lane[0];
+            shade(it, &it->lanes[lane[0]], &sp, emit_halves, &e);
+        } else {
+            for (int k = 0; k < n; k++) {
+                collect_ctx cc = {it, fr, lane[k]};
+                shade(it, &it->lanes[lane[k]], &sp, emit_collect, &cc);
+            }
+            emit_shared(it, fr, lane, n, src_object(it, h.object), &e);
         }
     }
     if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES)
@@ -1253,35 +1479,56 @@ static void pol_values(rs_worker *w, lp_vec3 o, lp_vec3 d, double *L)
 {
     const rs_integrator *it = w->it;
     int nl = it->n_lanes;
-    w->pixel.n = 0;
+    bundle_clear(&w->pixel);
     w->wavelets.n = 0;
     trace_pol(w, w->lane_all, nl, o, d, 1, 1.0, -1, 0, &w->pixel);
     const bundle *p = &w->pixel;
-    /* a stable counting sort of the rays by lane into w->one */
-    size_t *at = w->lane_at;
+    if (!it->interferes) {
+        /* every ray adds as an intensity: each lane's sum in its rays'
+         * order, as rs_coherent_power forms it */
+        for (int k = 0; k < nl; k++)
+            L[k] = 0.0;
+        for (size_t i = 0; i < p->n; i++)
+            FOR_LANES(p, i, nl, k, I, L[k] += I);
+        for (int k = 0; k < nl; k++)
+            L[k] = L[k] > 0.0 ? L[k] : 0.0;
+        return;
+    }
+    /* each lane's rays, in order, by a counting sort into w->one */
+    size_t *at = w->lane_at, total = 0;
     for (int k = 0; k <= nl; k++)
         at[k] = 0;
     for (size_t i = 0; i < p->n; i++)
-        at[p->lane[i] + 1]++;
+        FOR_LANES(p, i, nl, k, I, at[k + 1]++);
     for (int k = 0; k < nl; k++)
         at[k + 1] += at[k];
-    w->one.n = 0;
-    for (size_t i = 0; i < p->n; i++)
-        if (!bundle_push(&w->one, 0)) {
+    total = at[nl];
+    if (total > w->one_cap) {
+        const lp_ray **r = realloc(w->one, total * sizeof *r);
+        if (r)
+            w->one = r;
+        double *ii = r ? realloc(w->one_i, total * sizeof *ii) : NULL;
+        if (!r || !ii) {
             for (int k = 0; k < nl; k++)
                 L[k] = 0.0;
             return;
         }
+        w->one_i = ii;
+        w->one_cap = total;
+    }
     for (size_t i = 0; i < p->n; i++)
-        w->one.r[at[p->lane[i]]++] = p->r[i];
+        FOR_LANES(p, i, nl, k, I, {
+            w->one[at[k]] = &p->r[i];
+            w->one_i[at[k]++] = I;
+        });
     /* at[k] is now the end of lane k's rays */
     for (int k = 0; k < nl; k++) {
         size_t from = k ? at[k - 1] : 0;
-        /* a lane without rays sees nothing (w->one.r may not exist yet) */
+        /* a lane without rays sees nothing (w->one may not exist yet) */
         L[k] = at[k] == from ? 0.0
-                             : rs_coherent_power(w->one.r + from, at[k] - from, &w->wavelets,
-                                                 it->coherent, it->coherence, it->n_sources,
-                                                 it->lanes[k].lambda);
+                             : rs_coherent_power(w->one + from, w->one_i + from, at[k] - from,
+                                                 &w->wavelets, it->coherent, it->coherence,
+                                                 it->n_sources, it->lanes[k].lambda);
     }
 }
 
