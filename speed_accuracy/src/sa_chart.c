@@ -341,7 +341,7 @@ static const char *const PAGE_TEXT =
 "U and its largest error the last wavelength doubling's largest change),\n"
 "this chart and this page.\n"
 "\n"
-"The images are small (the size is in the tables' heading) so the sweep\n"
+"The images are small (the size is in the references' table) so the sweep\n"
 "finishes in reasonable time on a shared machine; errors are per pixel\n"
 "and depend little on size, times scale with the pixel count — except\n"
 "auto's probe, which has a floor of pixels and so weighs most at a small\n"

@@ -663,9 +663,9 @@ static int write_table(const sweep *w, FILE *csv, sa_points *all)
                       sc->ref_cutoff);
         snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
         snprintf(p.note, sizeof p.note,
-                 "last doubling of the wavelengths: max %.2g rmse %.2g; of the depth: max %.2g "
-                 "rmse %.2g; cut-off / 100: max %.2g rmse %.2g",
-                 sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max, sc->ref_dd_rmse,
+                 "%d x %d pixels; last doubling of the wavelengths: max %.2g rmse %.2g; of the "
+                 "depth: max %.2g rmse %.2g; cut-off / 100: max %.2g rmse %.2g",
+                 w->o->width, w->o->height, sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max, sc->ref_dd_rmse,
                  sc->ref_dc_max, sc->ref_dc_rmse);
         /* A reference's error columns: its own uncertainty (rmse: ref_u;
          * max_abs: the last wavelength doubling's largest change). */
