@@ -47,13 +47,13 @@ static const char *const usage_text[] = {
 "\n",
 "  --bin DIR        where lensrender and pov_compare are (default build/bin)\n"
 "  --work DIR       references and renders (default build/speed-accuracy)\n"
-"  --width W, --height H   image size of every render (default 32 x 24)\n"
+"  --width W, --height H   image size of every render (default 16 x 12)\n"
 "  --runs K         timed runs per setting; its time is their median\n"
 "                   (default 3; a setting slower than 1 s runs once)\n"
 "  --scene NAME     only this scene (repeatable; default every *.scene)\n"
 "  --max-wavelengths N   the reference's wavelength cap, <= 16384 (default 16384)\n"
 "  --reference-seconds S   no reference doubling predicted (2.5 x the last\n"
-"                   render) to take longer than S CPU seconds (default 60)\n"
+"                   render) to take longer than S CPU seconds (default 45)\n"
 "  --point-seconds S   no swept setting predicted (from the reference's time\n"
 "                   per wavelength) to take longer than S (default 10)\n"
 "  --reuse-references    keep references already in the work directory\n"
@@ -742,11 +742,11 @@ static int parse(opts *o, int argc, char **argv)
     o->scenes = "scenes";
     o->docs = "docs";
     o->work = "build/speed-accuracy";
-    o->width = 32;
-    o->height = 24;
+    o->width = 16;
+    o->height = 12;
     o->runs = 3;
     o->max_wavelengths = 16384;
-    o->reference_seconds = 60.0;
+    o->reference_seconds = 45.0;
     o->point_seconds = 10.0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
