@@ -104,19 +104,25 @@ struct rs_integrator {
                                    wavelength's CIE value, a line's XYZ) */
 };
 
-/* What a colour is in every lane (band_emission or band_reflectance of
+/* What a colour is in each lane (band_emission or band_reflectance of
  * it), kept per worker for the colours met last: a shaded point's
  * pigment, emission, ambient and mirror colours are few per scene, and
  * the spectral evaluation of one costs more than the rest of the shading.
- * One table per use, so that the values of a shaded point's colours stay
- * in place together. */
+ * One table per use, so that the colours of a shaded point stay in place
+ * together; a lane's value is evaluated when a packet with the lane first
+ * asks for it (a packet split at a dispersive lens has one lane).  An entry's
+ * lane values are valid where their stamp is the entry's generation. */
 enum { CC_EMISSION, CC_AMBIENT, CC_PIGMENT, CC_MIRROR_MAX, CC_MIRROR_MIN, CC_KINDS };
-#define RS_COLOUR_CACHE 64 /* entries per table, a power of 2 */
+#define RS_COLOUR_CACHE 64      /* most entries per table, a power of 2 */
+#define RS_COLOUR_CACHE_LANES 16384 /* entries x lanes per table at most */
 
 typedef struct colour_entry {
     rs_color c;
-    int used;
+    unsigned gen; /* 0: unused */
+    int n_valid;  /* lanes of this generation evaluated */
 } colour_entry;
+
+
 
 typedef struct frame {
     lp_backward *bw;
@@ -150,7 +156,9 @@ struct rs_worker {
     rs_wavelets wavelets; /* of the band being traced (coherence.h) */
     uint64_t splits;      /* crystal lens hits, for rs_coherence_split */
     colour_entry cc[CC_KINDS][RS_COLOUR_CACHE];
-    double *cc_val;       /* [(kind * RS_COLOUR_CACHE + entry) * n_lanes + lane] */
+    size_t cc_n;          /* entries used per table */
+    double *cc_val;       /* [(kind * cc_n + entry) * n_lanes + lane] */
+    unsigned *cc_stamp;   /* the same */
 };
 
 /* Source ids: 0 ambient, 1 background, 2 + k light k, 2 + L + i object i. */
@@ -369,9 +377,12 @@ rs_worker *rs_worker_create(const rs_integrator *it)
     w->lane_all = calloc((size_t)it->n_lanes, sizeof *w->lane_all);
     w->lane_value = calloc((size_t)it->n_lanes, sizeof *w->lane_value);
     w->lane_at = calloc((size_t)it->n_lanes + 1, sizeof *w->lane_at);
-    w->cc_val = calloc((size_t)CC_KINDS * RS_COLOUR_CACHE * (size_t)it->n_lanes,
-                       sizeof *w->cc_val);
-    if (!w->lane_all || !w->lane_value || !w->lane_at || !w->cc_val) {
+    w->cc_n = RS_COLOUR_CACHE;
+    while (w->cc_n > 1 && w->cc_n * (size_t)it->n_lanes > RS_COLOUR_CACHE_LANES)
+        w->cc_n /= 2;
+    w->cc_val = calloc((size_t)CC_KINDS * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_val);
+    w->cc_stamp = calloc((size_t)CC_KINDS * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_stamp);
+    if (!w->lane_all || !w->lane_value || !w->lane_at || !w->cc_val || !w->cc_stamp) {
         rs_worker_destroy(w);
         return NULL;
     }
@@ -414,6 +425,7 @@ void rs_worker_destroy(rs_worker *w)
     free(w->lane_value);
     free(w->lane_at);
     free(w->cc_val);
+    free(w->cc_stamp);
     free(w->pixel.r);
     free(w->pixel.lane);
     free(w->pixel.I);
@@ -616,9 +628,11 @@ static int make_lane_tables(rs_integrator *it)
     return 0;
 }
 
-/* The values of colour c in every lane for use `kind` (see colour_entry):
- * band_emission, or band_reflectance for the pigment and mirror colours. */
-static const double *lane_colour(rs_worker *w, int kind, rs_color c)
+/* Colour c for use `kind` (see colour_entry) in lanes lane[0..n), at
+ * [lane] of the array returned (the other lanes' values may be stale):
+ * band_reflectance for the pigment and mirror colours, band_emission for
+ * the others.  Valid until the next look-up of this kind. */
+static const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane, int n)
 {
     const rs_integrator *it = w->it;
     uint64_t u[3], h;
@@ -626,15 +640,29 @@ static const double *lane_colour(rs_worker *w, int kind, rs_color c)
     memcpy(&u[1], &c.g, sizeof u[1]);
     memcpy(&u[2], &c.b, sizeof u[2]);
     h = (u[0] * 0x9E3779B97F4A7C15u) ^ (u[1] * 0xC2B2AE3D27D4EB4Fu) ^ (u[2] * 0x165667B19E3779F9u);
-    size_t e = (size_t)(h >> 58) & (RS_COLOUR_CACHE - 1);
+    size_t e = (size_t)(h >> 58) & (w->cc_n - 1);
     colour_entry *ce = &w->cc[kind][e];
-    double *v = w->cc_val + ((size_t)kind * RS_COLOUR_CACHE + e) * (size_t)it->n_lanes;
-    if (!ce->used || memcmp(&ce->c, &c, sizeof c) != 0) {
-        int refl = kind == CC_PIGMENT || kind == CC_MIRROR_MAX || kind == CC_MIRROR_MIN;
-        for (int k = 0; k < it->n_lanes; k++)
-            v[k] = refl ? band_reflectance(&it->lanes[k], c) : band_emission(&it->lanes[k], c);
+    size_t at = ((size_t)kind * w->cc_n + e) * (size_t)it->n_lanes;
+    double *v = w->cc_val + at;
+    unsigned *stamp = w->cc_stamp + at;
+    if (ce->gen == 0 || memcmp(&ce->c, &c, sizeof c) != 0) {
         ce->c = c;
-        ce->used = 1;
+        ce->n_valid = 0;
+        if (++ce->gen == 0) { /* wrapped: no stamp may match a new generation */
+            memset(stamp, 0, (size_t)it->n_lanes * sizeof *stamp);
+            ce->gen = 1;
+        }
+    }
+    if (ce->n_valid == it->n_lanes)
+        return v;
+    int refl = kind == CC_PIGMENT || kind == CC_MIRROR_MAX || kind == CC_MIRROR_MIN;
+    for (int k = 0; k < n; k++) {
+        int l = lane[k];
+        if (stamp[l] == ce->gen)
+            continue;
+        v[l] = refl ? band_reflectance(&it->lanes[l], c) : band_emission(&it->lanes[l], c);
+        stamp[l] = ce->gen;
+        ce->n_valid++;
     }
     return v;
 }
@@ -823,11 +851,13 @@ typedef struct shade_point {
     rs_color pig;
     lp_vec3 x;
     double *cb, *s, *reach; /* per light */
-    /* per lane (lane_colour): valid until the worker shades another point */
+    /* per lane of the packet (lane_colour): valid until the worker shades
+     * another point */
     const double *emission, *ambient, *pigment;
 } shade_point;
 
-static void shade_begin(rs_worker *w, const rs_hit *h, lp_vec3 dir, frame *fr, shade_point *sp)
+static void shade_begin(rs_worker *w, const int *lane, int n, const rs_hit *h, lp_vec3 dir,
+                        frame *fr, shade_point *sp)
 {
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
@@ -835,10 +865,10 @@ static void shade_begin(rs_worker *w, const rs_hit *h, lp_vec3 dir, frame *fr, s
     const rs_finish *f = &o->finish;
     sp->h = h;
     sp->pig = pigment_at(&o->pigment, h->point);
-    sp->emission = lane_colour(w, CC_EMISSION, mul(sp->pig, f->emission));
-    sp->ambient =
-        lane_colour(w, CC_AMBIENT, mul(sp->pig, mul(f->ambient, sc->settings.ambient_light)));
-    sp->pigment = lane_colour(w, CC_PIGMENT, sp->pig);
+    sp->emission = lane_colour(w, CC_EMISSION, mul(sp->pig, f->emission), lane, n);
+    sp->ambient = lane_colour(w, CC_AMBIENT,
+                              mul(sp->pig, mul(f->ambient, sc->settings.ambient_light)), lane, n);
+    sp->pigment = lane_colour(w, CC_PIGMENT, sp->pig, lane, n);
     sp->x = v3_madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(v3_dot(h->point, h->point))));
     sp->cb = fr->cb;
     sp->s = fr->hs;
@@ -896,30 +926,35 @@ static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_
     }
 }
 
-/* The mirror reflectivity of a surface in this band for a ray along d
- * (0: none): `reflection` as min + (max - min) F, F the unpolarized Fresnel
- * reflectance into the object's ior with fresnel on, else max. */
-static double reflectivity(rs_worker *w, int lane, const rs_object *o, const rs_hit *h,
-                           lp_vec3 d)
+/* The mirror reflectivity of a surface in each lane lane[k] of a packet
+ * for a ray along d, into r[k] (0: none): `reflection` as
+ * min + (max - min) F, F the unpolarized Fresnel reflectance into the
+ * object's ior with fresnel on, else max. */
+static void reflectivities(rs_worker *w, const int *lane, int n, const rs_object *o,
+                           const rs_hit *h, lp_vec3 d, double *r)
 {
     const rs_finish *f = &o->finish;
-    double rmax = lane_colour(w, CC_MIRROR_MAX, f->reflection_max)[lane];
-    if (!f->fresnel)
-        return rmax;
-    double rmin = lane_colour(w, CC_MIRROR_MIN, f->reflection_min)[lane];
-    double ci = -v3_dot(d, h->normal), n = o->ior;
+    const double *rmax = lane_colour(w, CC_MIRROR_MAX, f->reflection_max, lane, n);
+    if (!f->fresnel) {
+        for (int k = 0; k < n; k++)
+            r[k] = rmax[lane[k]];
+        return;
+    }
+    const double *rmin = lane_colour(w, CC_MIRROR_MIN, f->reflection_min, lane, n);
+    double ci = -v3_dot(d, h->normal), nn = o->ior;
     double F = 0.0;
     if (ci > 1.0)
         ci = 1.0;
-    double st2 = (1.0 - ci * ci) / (n * n);
+    double st2 = (1.0 - ci * ci) / (nn * nn);
     if (st2 >= 1.0) {
         F = 1.0;
-    } else if (n != 1.0) {
+    } else if (nn != 1.0) {
         double ct = sqrt(1.0 - st2);
-        double rs = (ci - n * ct) / (ci + n * ct), rp = (n * ci - ct) / (n * ci + ct);
+        double rs = (ci - nn * ct) / (ci + nn * ct), rp = (nn * ci - ct) / (nn * ci + ct);
         F = 0.5 * (rs * rs + rp * rp);
     }
-    return rmin + (rmax - rmin) * F;
+    for (int k = 0; k < n; k++)
+        r[k] = rmin[lane[k]] + (rmax[lane[k]] - rmin[lane[k]]) * F;
 }
 
 static int has_reflection(const rs_finish *f)
@@ -1032,7 +1067,7 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     if (!fr)
         return;
     shade_point sp;
-    shade_begin(w, &h, d, fr, &sp);
+    shade_begin(w, lane, n, &h, d, fr, &sp);
     for (int k = 0; k < n; k++)
         shade(it, &it->lanes[lane[k]], &sp, emit_sum, &out[k]);
     if (!has_reflection(&ob->finish) || level >= it->max_level || f + 1 >= RS_MAX_FRAMES)
@@ -1041,9 +1076,9 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     lp_vec3 x = v3_madd(h.point, h.normal, 1e-9 * (1.0 + sqrt(v3_dot(h.point, h.point))));
     /* The mirror ray, shared by the lanes of equal reflectivity (they
      * carry the same weight on). */
+    reflectivities(w, lane, n, ob, &h, d, fr->val);
     for (int k = 0; k < n; k++) {
-        double r = reflectivity(w, lane[k], ob, &h, d);
-        fr->val[k] = r;
+        double r = fr->val[k];
         fr->done[k] = !(r > 0.0 && weight * r >= it->cutoff);
     }
     for (int k = 0; k < n; k++) {
@@ -1194,9 +1229,9 @@ static void mirror_pol(rs_worker *w, const int *lane, int n, const rs_object *ob
     lp_vec3 nv = h->normal;
     lp_vec3 rd = v3_unit_or_self(v3_madd(d, nv, -2.0 * v3_dot(d, nv)));
     lp_vec3 x = v3_madd(h->point, nv, 1e-9 * (1.0 + sqrt(v3_dot(h->point, h->point))));
+    reflectivities(w, lane, n, ob, h, d, fr->val);
     for (int k = 0; k < n; k++) {
-        double r = reflectivity(w, lane[k], ob, h, d);
-        fr->val[k] = r;
+        double r = fr->val[k];
         fr->done[k] = !(r > 0.0) || weight * r < it->cutoff;
     }
     for (int k = 0; k < n; k++) {
@@ -1456,7 +1491,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
     emit_ctx e = emit_ctx_make(out, d, record_wavelet(w, o, d, &h));
     if (e.wavelet >= 0) {
         shade_point sp;
-        shade_begin(w, &h, d, fr, &sp);
+        shade_begin(w, lane, n, &h, d, fr, &sp);
         if (n == 1) {
             e.lane = lane[0];
             shade(it, &it->lanes[lane[0]], &sp, emit_halves, &e);
