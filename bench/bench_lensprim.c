@@ -5,12 +5,16 @@
  * (one call per ray and the batch entry point) and backward (build +
  * gather of a one-ray bundle per query), on one thread, and prints
  * nodes/s and the time ratio of each mode to polarized measured in the
- * same run.  Usage: bench_lensprim [rays] (default 200000). */
+ * same run.  Usage:
+ *     bench_lensprim [RAYS] [--mode polarized|fresnel|schlick] [--depth N]
+ * RAYS defaults to 200000; --mode and --depth keep one row each (for a
+ * profiler); without them every mode at depths 2, 5 and 20 is printed. */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "lensprim.h"
@@ -51,12 +55,38 @@ static void random_ray(lp_ray *r)
 
 int main(int argc, char **argv)
 {
-    size_t n = argc > 1 ? strtoul(argv[1], NULL, 10) : 200000;
+    size_t n = 200000;
+    int only_mode = -1, only_depth = 0;
     lp_lens_desc desc;
     lp_lens *lens;
     lp_error err;
     const char *mode_name[] = {"polarized", "fresnel", "schlick"};
     const int depths[] = {2, 5, 20};
+
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--mode") == 0 && i + 1 < argc) {
+            i++;
+            for (int m = 0; m < 3; m++)
+                if (strcmp(argv[i], mode_name[m]) == 0)
+                    only_mode = m;
+            if (only_mode < 0) {
+                fprintf(stderr, "bench: unknown mode %s\n", argv[i]);
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--depth") == 0 && i + 1 < argc) {
+            only_depth = atoi(argv[++i]);
+            if (only_depth < 1 || only_depth > LP_MAX_DEPTH) {
+                fprintf(stderr, "bench: depth must be in 1..%d\n", LP_MAX_DEPTH);
+                return 2;
+            }
+        } else if (argv[i][0] != '-' && strtoul(argv[i], NULL, 10) > 0) {
+            n = strtoul(argv[i], NULL, 10);
+        } else {
+            fprintf(stderr, "usage: bench_lensprim [RAYS] [--mode M] [--depth N]\n");
+            return 2;
+        }
+    }
+    int n_depths = only_depth ? 1 : (int)(sizeof depths / sizeof depths[0]);
 
     lp_lens_desc_init(&desc);
     desc.radius1 = 50;
@@ -83,13 +113,15 @@ int main(int argc, char **argv)
     printf("%zu rays, one thread\n", n);
     printf("%-10s %5s %14s %14s %14s %10s\n", "mode", "depth", "fwd nodes/s", "batch nodes/s",
            "bwd nodes/s", "fwd t/pol");
-    for (size_t di = 0; di < sizeof depths / sizeof depths[0]; di++) {
+    for (int di = 0; di < n_depths; di++) {
         double t_pol = 0.0;
         for (int m = 0; m < 3; m++) {
+            if (only_mode >= 0 && m != only_mode)
+                continue;
             lp_trace_args a;
             lp_trace_args_init(&a);
             a.mode = (lp_mode)m;
-            a.max_depth = depths[di];
+            a.max_depth = only_depth ? only_depth : depths[di];
 
             size_t nodes = 0;
             double t0 = now();
@@ -122,8 +154,9 @@ int main(int argc, char **argv)
             double t_bwd = now() - t0;
             if (m == 0)
                 t_pol = t_fwd;
-            printf("%-10s %5d %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], depths[di],
-                   nodes / t_fwd, batch_nodes / t_batch, bnodes / t_bwd, t_fwd / t_pol);
+            printf("%-10s %5d %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], a.max_depth,
+                   nodes / t_fwd, batch_nodes / t_batch, bnodes / t_bwd,
+                   t_pol > 0.0 ? t_fwd / t_pol : 1.0);
         }
     }
     lp_backward_destroy(bw);

@@ -37,12 +37,26 @@ typedef struct lp__payload {
     uint64_t ch;
 } lp__payload;
 
-/* Append the field E leaving the lens (local point p, local unit dir d)
- * to res as one or two linear rays.  Returns LP_ERROR_NO_MEMORY or LP_OK;
- * adds their power to res->out. */
-lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
-                   lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
-                   uint64_t path, lp_error *err);
+/* Where an outgoing ray leaves: its local unit direction d, and its world
+ * origin and direction. */
+typedef struct lp__exit {
+    lp_vec3 d;
+    lp_vec3 world_origin, world_dir;
+} lp__exit;
+
+/* The exit of a ray leaving the lens's local point p along the local unit
+ * direction d. */
+lp__exit lp__exit_at(const lp_lens *lens, lp_vec3 p, lp_vec3 d);
+
+/* Append the field E leaving the lens at x to res as one or two linear
+ * rays.  Returns LP_ERROR_NO_MEMORY or LP_OK; adds their power to
+ * res->out. */
+lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
+                   const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
+                   lp_error *err);
+
+/* x wrapped into [-pi, pi] (x itself when it lies there already). */
+double lp__wrap_phase(double x);
 
 /* Send one outgoing field (branch b, leaving the local point p) to the
  * result, or count its power as skipped when args' flags or filter
@@ -59,10 +73,10 @@ lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 lig
 
 /* Emit a gathered field E (of a bundle ray of power `in`, of which
  * `absorbed` went into the glass) as the rays of query q, leaving the
- * local point p along d; the rest of `in` is counted as truncated. */
-lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
-                            lp_vec3 d, const lp__payload *pl, const lp_query *q, double in,
-                            double absorbed, lp_error *err);
+ * lens at x; the rest of `in` is counted as truncated. */
+lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
+                            const lp__exit *x, const lp__payload *pl, const lp_query *q,
+                            double in, double absorbed, lp_error *err);
 
 /* Make v a unit vector perpendicular to the unit d; 0 if impossible. */
 int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out);

@@ -100,8 +100,11 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
         }
         /* Along the segment: Beer-Lambert and the optical path. */
         if (o.alpha > 0.0) {
-            res->absorbed_glass += power * -expm1(-o.alpha * h.t);
-            E = cv3_scale(E, exp(-0.5 * o.alpha * h.t));
+            /* amplitude 1 + m, m = expm1(-alpha t / 2); absorbed power
+             * 1 - (1 + m)^2 = -m (2 + m), free of cancellation */
+            double m = expm1(-0.5 * o.alpha * h.t);
+            res->absorbed_glass += power * (-m * (2.0 + m));
+            E = cv3_scale_real(E, 1.0 + m);
         }
         pl.op += o.n_glass * h.t;
         p = h.p;

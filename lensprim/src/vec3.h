@@ -37,6 +37,9 @@ static inline lp_vec3 v3_normalize(lp_vec3 a)
     a = v3(a.x / m, a.y / m, a.z / m); /* not * (1/m): 1/m can overflow */
     return v3_scale(a, 1.0 / v3_len(a));
 }
+/* The larger of two numbers that are not NaN (inline,
+ * unlike fmax, which must handle NaN). */
+static inline double lp__max(double a, double b) { return a > b ? a : b; }
 /* Any unit vector perpendicular to the unit vector a (deterministic). */
 static inline lp_vec3 v3_any_perp(lp_vec3 a)
 {
