@@ -44,14 +44,12 @@ void lp__fresnel_eval(double cos_i, double n1, double n2, lp__fresnel *f)
         double sin_i = sqrt((1.0 - ci) * (1.0 + ci));
         double q2 = (n1 * sin_i - n2) * (n1 * sin_i + n2);
         double q = sqrt(q2 > 0.0 ? q2 : 0.0);
-        /* r = (a - i b)/(a + i b) = ((a^2 - b^2) - 2 i a b)/(a^2 + b^2):
-         * s with a = n1 ci, b = q; p with a = n2^2 ci, b = n1 q. */
-        double as = n1 * ci, ap = n2 * n2 * ci, bp = n1 * q;
-        double is = 1.0 / (as * as + q * q), ip = 1.0 / (ap * ap + bp * bp);
+        double complex a = n1 * ci, b = I * q;
+        double complex ap = n2 * n2 * ci, bp = I * n1 * q;
         f->tir = 1;
         f->cos_t = 0.0;
-        f->rs = CMPLX((as * as - q * q) * is, -2.0 * as * q * is);
-        f->rp = CMPLX((ap * ap - bp * bp) * ip, -2.0 * ap * bp * ip);
+        f->rs = (a - b) / (a + b);
+        f->rp = (ap - bp) / (ap + bp);
         f->ts = f->tp = 0.0;
         f->Rs = f->Rp = 1.0;
         return;

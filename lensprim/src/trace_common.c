@@ -89,16 +89,6 @@ int lp__branch_keep(const lp_lens *lens, const lp_trace_args *a, int depth, lp_k
     return lp__args_keep(a, info);
 }
 
-int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
-{
-    lp_vec3 w = v3_sub(v, v3_scale(d, v3_dot(v, d)));
-    double l = v3_len(w), lv = v3_len(v);
-    if (!(l > 1e-12 * lv) || !isfinite(l))
-        return 0;
-    *out = v3_scale(w, 1.0 / l);
-    return 1;
-}
-
 lp__exit lp__exit_at(const lp_lens *lens, lp_vec3 p, lp_vec3 d)
 {
     lp__exit x = {d, lp__to_world_point(lens, p), lp__to_world_dir(lens, d)};
