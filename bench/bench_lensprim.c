@@ -2,7 +2,8 @@
  *
  * A benchmark, not a test: it traces random rays through the default lens
  * (biconvex N-BK7, R 50/-50, t 8, D 25) in each mode and depth, forward
- * (one call per ray and the batch entry point) and backward (build +
+ * (one call per ray, lp_trace_forward_many, and lp_trace_forward_soa on
+ * groups of 64 rays, each group at one wavelength) and backward (build +
  * gather of a one-ray bundle per query), on one thread, and prints
  * nodes/s and the time ratio of each mode to polarized measured in the
  * same run.  Usage:
@@ -104,6 +105,20 @@ int main(int argc, char **argv)
         return 1;
     for (size_t i = 0; i < n; i++)
         random_ray(&rays[i]);
+    /* the same rays as arrays for lp_trace_forward_soa */
+    const size_t soa_group = 64;
+    double *soa = malloc(10 * n * sizeof *soa);
+    if (!soa)
+        return 1;
+    double *sox = soa, *soy = soa + n, *soz = soa + 2 * n, *sdx = soa + 3 * n,
+           *sdy = soa + 4 * n, *sdz = soa + 5 * n, *svx = soa + 6 * n, *svy = soa + 7 * n,
+           *svz = soa + 8 * n, *sin_ = soa + 9 * n;
+    for (size_t i = 0; i < n; i++) {
+        sox[i] = rays[i].origin.x, soy[i] = rays[i].origin.y, soz[i] = rays[i].origin.z;
+        sdx[i] = rays[i].dir.x, sdy[i] = rays[i].dir.y, sdz[i] = rays[i].dir.z;
+        svx[i] = rays[i].vp.x, svy[i] = rays[i].vp.y, svz[i] = rays[i].vp.z;
+        sin_[i] = rays[i].intensity;
+    }
 
     lp_result res;
     lp_result_init(&res);
@@ -111,8 +126,8 @@ int main(int argc, char **argv)
     lp_backward_create(&bw, &err);
 
     printf("%zu rays, one thread\n", n);
-    printf("%-10s %5s %14s %14s %14s %10s\n", "mode", "depth", "fwd nodes/s", "batch nodes/s",
-           "bwd nodes/s", "fwd t/pol");
+    printf("%-10s %5s %14s %14s %14s %14s %10s\n", "mode", "depth", "fwd nodes/s",
+           "batch nodes/s", "soa nodes/s", "bwd nodes/s", "fwd t/pol");
     for (int di = 0; di < n_depths; di++) {
         double t_pol = 0.0;
         for (int m = 0; m < 3; m++) {
@@ -136,6 +151,19 @@ int main(int argc, char **argv)
             double t_batch = now() - t0;
             size_t batch_nodes = res.nodes;
 
+            /* the arrays entry point, one wavelength per call: the rays in
+             * groups of soa_group, each group at its first ray's lambda */
+            size_t soa_nodes = 0;
+            t0 = now();
+            for (size_t i = 0; i < n; i += soa_group) {
+                size_t m = n - i < soa_group ? n - i : soa_group;
+                lp_ray_soa s = {sox + i, soy + i, soz + i, sdx + i, sdy + i, sdz + i, svx + i,
+                                svy + i, svz + i, sin_ + i, NULL, NULL, NULL, NULL};
+                lp_trace_forward_soa(lens, rays[i].lambda_nm, &s, m, &a, &res, offsets, NULL);
+                soa_nodes += res.nodes;
+            }
+            double t_soa = now() - t0;
+
             size_t bnodes = 0;
             t0 = now();
             for (size_t i = 0; i < n; i++) {
@@ -154,8 +182,8 @@ int main(int argc, char **argv)
             double t_bwd = now() - t0;
             if (m == 0)
                 t_pol = t_fwd;
-            printf("%-10s %5d %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], a.max_depth,
-                   nodes / t_fwd, batch_nodes / t_batch, bnodes / t_bwd,
+            printf("%-10s %5d %14.3e %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], a.max_depth,
+                   nodes / t_fwd, batch_nodes / t_batch, soa_nodes / t_soa, bnodes / t_bwd,
                    t_pol > 0.0 ? t_fwd / t_pol : 1.0);
         }
     }
@@ -163,6 +191,7 @@ int main(int argc, char **argv)
     lp_result_release(&res);
     free(rays);
     free(offsets);
+    free(soa);
     lp_lens_destroy(lens);
     return 0;
 }
