@@ -30,7 +30,7 @@
 #define RS_ARGS_SIZE_MAX 16384                     /* --width, --height */
 #define RS_ARGS_PIXELS_MAX (64LL * 1024 * 1024)    /* W * H */
 #define RS_ARGS_DEPTH_MAX 256                      /* POV-Ray's max_trace_level */
-#define RS_ARGS_WAVELENGTHS_MAX 1024
+#define RS_ARGS_WAVELENGTHS_MAX 16384
 #define RS_ARGS_THREADS_MAX 1024
 #define RS_ARGS_AA_MAX 16                          /* --aa: N x N per pixel */
 #define RS_ARGS_LIBRARY_MAX 32                     /* -L directories */
@@ -48,7 +48,7 @@ typedef struct rs_args {
                              scene */
     rs_mode mode;         /* default RS_MODE_POLARIZED */
     int depth;            /* 1..256; 0 = the scene's max_trace_level */
-    int wavelengths;      /* 1..1024; default 16 */
+    int wavelengths;      /* 1..16384; default 16 */
     int wavelengths_given;/* --wavelengths was on the command line */
     int threads;          /* 1..1024; 0 = every online processor (default) */
     double cutoff;        /* 0..1; < 0 = the scene's adc_bailout (default) */

@@ -333,7 +333,7 @@ static const char *opts_problem(const lr_render_opts *o)
     if (o->depth < 0 || o->depth > LR_DEPTH_MAX)
         return "depth must be 0 (the scene's) or 1..256";
     if (o->wavelengths < 0 || o->wavelengths > LR_WAVELENGTHS_MAX)
-        return "wavelengths must be 0 (the default) or 1..1024";
+        return "wavelengths must be 0 (the default) or 1..16384";
     if (isnan(o->cutoff) || o->cutoff > 1.0)
         return "cutoff must be at most 1 (< 0: the scene's adc_bailout)";
     if (o->aa < 1 || o->aa > LR_AA_MAX)

@@ -60,7 +60,7 @@ static const char *const usage_text[] = {
 "                      (default 1e-3)\n",
 "  --depth N           max trace level 1..256 (default: the scene's\n"
 "                      global_settings max_trace_level, 5 if none)\n"
-"  --wavelengths N     spectral samples per pixel, 1..1024 (default 16)\n"
+"  --wavelengths N     spectral samples per pixel, 1..16384 (default 16)\n"
 "  --cutoff F          drop branches whose weight is below F, 0..1\n"
 "                      (default: the scene's adc_bailout, 1/255 if none)\n"
 "  --threads N         worker threads, 1..1024 (default 0: every core)\n"

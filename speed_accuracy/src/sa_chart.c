@@ -21,6 +21,7 @@ static const unsigned TOL_COLOR[3] = {0x1f77b4u, 0x2ca02cu, 0x9467bdu};
 #define FRONT_COLOR 0xff7f0eu
 #define POV_COLOR 0xd62728u
 #define SWEEP_COLOR 0x9a9a9au
+#define UNCERTAIN_COLOR 0x404040u
 
 static int is(const sa_point *p, const char *kind)
 {
@@ -114,6 +115,22 @@ static size_t swept(const sa_points *ps, const char *scene, const sa_point **out
     return n;
 }
 
+static const sa_point *find(const sa_points *ps, const char *scene, const char *kind, double tol);
+
+/* The reference's own uncertainty U (an RMSE): a measured error e means
+ * a true error within e +- U.  Infinite when not known. */
+static double uncertainty(const sa_points *ps, const char *scene)
+{
+    const sa_point *r = find(ps, scene, "reference", 0.0);
+    return r && isfinite(r->err.rmse) ? r->err.rmse : INFINITY;
+}
+
+/* A measured error e meets E when even e + U does. */
+static int meets(double e, double u, double tol)
+{
+    return e + u <= tol;
+}
+
 static int draw_panel(rs_image *img, int x0, int y0, const sa_points *ps, const char *scene,
                       pieces *pc, char *msg, size_t msg_size)
 {
@@ -153,13 +170,20 @@ static int draw_panel(rs_image *img, int x0, int y0, const sa_points *ps, const 
         double x[2] = {ch.xmin, ch.xmax}, y[2] = {TOLS[t], TOLS[t]};
         add_line(pc, x, y, 2, TOL_COLOR[t], PL_DOTTED, 1.5, NULL);
     }
+    double u = uncertainty(ps, scene);
+    if (isfinite(u) && u > ch.ymin) {
+        double x[2] = {ch.xmin, ch.xmax}, y[2] = {u, u};
+        add_line(pc, x, y, 2, UNCERTAIN_COLOR, PL_DASHED, 2.0, NULL);
+    }
     for (size_t k = 0; k < n; k++)
         add_marker(pc, log10(sw[k]->seconds), err_y(sw[k]->err.rmse), sx, fy, 0, SWEEP_COLOR, 1.2);
-    /* The Pareto front: each point faster than all that are more accurate. */
+    /* The Pareto front: each point faster than all that are more accurate.
+     * Errors below U cannot be told apart: the front ends at the first
+     * point that reaches U. */
     {
         double best = INFINITY, px = NAN, py = NAN;
         for (size_t k = 0; k < n; k++) {
-            double e = err_y(sw[k]->err.rmse);
+            double e = err_y(fmax(sw[k]->err.rmse, isfinite(u) ? u : 0.0));
             if (!(e < best))
                 continue;
             double x = log10(sw[k]->seconds);
@@ -215,6 +239,7 @@ static int write_png(const sa_points *ps, const char **names, size_t ns, const c
         pl_text(&img, x + 260, y + 30, 2, TOL_COLOR[1], "<> auto, E = 1e-3");
         pl_text(&img, x + 520, y + 30, 2, TOL_COLOR[2], "<> auto, E = 1e-4");
         pl_text(&img, x + 820, y + 30, 2, 0x606060u, "dotted: the three E");
+        pl_text(&img, x + 820, y, 2, UNCERTAIN_COLOR, "dashed: the reference's U");
         snprintf(path, sizeof path, "%s/speed-accuracy.png", dir);
         rc = rs_png_write(path, &img, msg, msg_size);
     }
@@ -255,52 +280,72 @@ static const char *const PAGE_TEXT =
 "setting — light model × wavelength count × depth × branch cut-off — at\n"
 "its cost (x: CPU seconds of the `lensrender` process on one thread,\n"
 "logarithmic) and its error (y: RMSE of linear RGB against the scene's\n"
-"converged reference, logarithmic).  The orange line is the Pareto front:\n"
-"the settings that no other swept setting beats in both time and error.\n"
-"The red × is POV-Ray 3.7 rendering the same scene (translated by\n"
-"`pov_compare`: glass a constant index n_d, no dispersion, no polarizers,\n"
-"one thread), against the same reference — its error is what leaving out\n"
-"dispersion and polarization costs.  The diamonds are `--mode auto\n"
-"--tolerance E` for E = 1e-2 (blue), 1e-3 (green), 1e-4 (purple), and\n"
-"the dotted lines the three E: a diamond should lie below its own line\n"
-"and near the front's left end below that line.\n"
+"reference, logarithmic).  The dashed dark line is the reference's own\n"
+"uncertainty U (below): an error under it is not a measurement, only a\n"
+"bound (the true error is at most the measured one plus U).  The orange\n"
+"line is the Pareto front: the settings that no other swept setting\n"
+"beats in both time and error, errors under U counted as U (they cannot\n"
+"be told apart), so the front ends where it first reaches U.  The red ×\n"
+"is POV-Ray 3.7 rendering the same scene (translated by `pov_compare`:\n"
+"glass a constant index n_d, no dispersion, no polarizers, one thread),\n"
+"against the same reference — its error is what leaving out dispersion\n"
+"and polarization costs.  The diamonds are `--mode auto --tolerance E`\n"
+"for E = 1e-2 (blue), 1e-3 (green), 1e-4 (purple), and the dotted lines\n"
+"the three E: a diamond should lie below its own line and near the\n"
+"front's left end below that line.\n"
 "\n"
 "**Reading it.** Move left along the front to see how much accuracy a\n"
 "faster setting gives up; a setting far right of the front at the same\n"
 "height wastes time.  Wavelengths are the main cost and, through\n"
-"dispersion, the main error: at a coloured edge seen through glass the\n"
-"integrand over wavelength has a step, so the midpoint rule's error\n"
-"falls only as 1/N.  Depth and cut-off matter less once the tree is\n"
-"deep enough; the light model matters where polarization does (the\n"
-"polarizer scenes, strong ghosts in dense glass).\n"
+"dispersion, the main error: where a pixel's path changes with the\n"
+"wavelength (a dispersed ray crossing a checker edge or a rim, TIR\n"
+"setting in) the integrand over wavelength has a step, so the midpoint\n"
+"rule's error falls only as 1/N.  Depth and cut-off matter less once the\n"
+"tree is deep enough; the light model matters where polarization does\n"
+"(the polarizer and crystal scenes, strong ghosts in dense glass).\n"
+"\n"
+"**The reference.** Polarized.  At 128 wavelengths the depth is doubled\n"
+"from 16 (to 64) and the cut-off divided by 100 from 1e-10 (to 1e-14)\n"
+"while that changes some pixel by more than 1e-5; then the wavelength\n"
+"count is doubled from 128 while the doubling changes some pixel by more\n"
+"than 1e-5, up to 16384 or until the next doubling is predicted to take\n"
+"more CPU time than the budget (`--reference-seconds`).  A cut-off, not\n"
+"none: a branch below 1e-10 of the light changes a pixel by at most 1e-10\n"
+"of the brightest radiance (2e-5 through interference), while without one\n"
+"a birefringent plate's tree doubles at every bounce.  The midpoint rule's\n"
+"1/N error means the last doubling's change is about the coarser render's\n"
+"error, twice the finer one's; U, the RMSE changes of the last wavelength\n"
+"doubling, depth doubling and cut-off step summed, bounds the reference's\n"
+"RMSE from the converged image.  Where the table below shows a last\n"
+"doubling's largest pixel change above 1e-5, the reference did NOT\n"
+"converge to 1e-5 per pixel within its budget, and the figures are what\n"
+"it reaches.\n"
 "\n"
 "**How it is measured.** `sh scripts/speed_accuracy.sh` builds the\n"
 "project and runs `build/bin/speed_accuracy`, which for every scene\n"
+"renders the reference, then every swept setting, auto at the three E,\n"
+"the renderer's default (polarized, 16 wavelengths, the scene's depth and\n"
+"`adc_bailout`) and POV-Ray, each `--runs` times (default 3; a setting\n"
+"slower than 1 s once), and takes the median CPU time (user + system of\n"
+"the child process, from `wait4`): the machine is shared, and CPU time\n"
+"does not count the time other work held the cores, wall time would.\n"
+"A swept setting whose time, predicted from the reference's time per\n"
+"wavelength, exceeds `--point-seconds` is not run (the expensive scenes'\n"
+"highest wavelength counts).  The sweep: polarized and fresnel at 4-32\n"
+"wavelengths × depth 4, 8, 16 × cut-off 1e-6, 1e-3, the scene's; at 64-512\n"
+"wavelengths depth 16 with 1e-6 and depth 8 with 1e-3; schlick at depth 16\n"
+"with 1e-6; rgb at every depth and cut-off.  It writes `speed-accuracy.csv`\n"
+"(every point: scene, kind, model, wavelengths, depth, cut-off, tolerance,\n"
+"seconds, runs, rmse, largest channel error, share of pixels off by more\n"
+"than 1/255 after the sRGB curve, note; a reference's rmse column is its\n"
+"U and its largest error the last wavelength doubling's largest change),\n"
+"this chart and this page.\n"
 "\n"
-"1. renders the reference: polarized, no cut-off, wavelengths from 64\n"
-"   and depth from 16, each doubled while the doubling changes some\n"
-"   pixel by more than 1e-5 (caps: 1024 wavelengths, the renderer's\n"
-"   limit, and depth 64); the\n"
-"   table below gives the last doubling's change, which is the\n"
-"   reference's own uncertainty;\n"
-"2. renders every swept setting, auto at the three E, the renderer's\n"
-"   default (polarized, 16 wavelengths, the scene's depth and\n"
-"   `adc_bailout`) and POV-Ray, each `--runs` times (default 3; a setting\n"
-"   slower than 5 s once) and takes the median CPU time (user + system of\n"
-"   the child process, from `wait4`): the machine these figures come\n"
-"   from is shared, and CPU time does not count the time other work held\n"
-"   the cores, wall time would (with 8 engineers' work on 2 cores a\n"
-"   render's wall time was 5-25 times its CPU time);\n"
-"3. writes `speed-accuracy.csv` (every point: scene, kind, model,\n"
-"   wavelengths, depth, cut-off, tolerance, seconds, runs, rmse, largest\n"
-"   channel error, share of pixels off by more than 1/255 after the sRGB\n"
-"   curve, note), this chart and this page.\n"
-"\n"
-"The images are small (32 × 24 by default) so the sweep finishes in\n"
-"reasonable time; errors are per pixel and depend little on size, times\n"
-"scale with the pixel count -- except auto's probe, which has a floor of\n"
-"64 pixels and so weighs most at this size.  A scene missing from the\n"
-"chart was not swept (see the CSV).\n"
+"The images are small (the size is in the references' table) so the sweep\n"
+"finishes in reasonable time on a shared machine; errors are per pixel\n"
+"and depend little on size, times scale with the pixel count — except\n"
+"auto's probe, which has a floor of pixels and so weighs most at a small\n"
+"size.\n"
 "\n";
 
 static int write_md(const sa_points *ps, const char **names, size_t ns, const char *dir,
@@ -317,43 +362,55 @@ static int write_md(const sa_points *ps, const char **names, size_t ns, const ch
     }
     fputs(PAGE_TEXT, f);
     fputs("## Auto against the front\n\n"
-          "Per scene and E: auto's choice, its error and time; the cheapest swept\n"
-          "setting whose error is ≤ E; auto's time over that one's (the goal is\n"
-          "≤ 1.25) and over the default polarized render's.\n\n"
-          "| scene | E | auto's choice | auto rmse | auto s | cheapest swept ≤ E | its rmse | its s "
-          "| auto / cheapest | auto / default |\n"
-          "|---|---|---|---|---|---|---|---|---|---|\n", f);
+          "Per scene and E: auto's choice, its error and time, and whether it meets\n"
+          "E: *yes* when its error + U ≤ E, *no* when its error − U > E, *unresolved*\n"
+          "between (the reference cannot tell); the cheapest swept setting that meets\n"
+          "E the same way (error + U ≤ E; none when U ≥ E: E is below what the\n"
+          "reference resolves); auto's time over that one's (the goal is ≤ 1.25) and\n"
+          "over the default polarized render's.\n\n"
+          "| scene | E | auto's choice | auto rmse | meets E | auto s | cheapest swept meeting E "
+          "| its rmse | its s | auto / cheapest | auto / default |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|\n", f);
     for (size_t k = 0; k < ns; k++) {
         const sa_point *dflt = find(ps, names[k], "default", 0.0);
         const sa_point *sw[1024];
         size_t n = swept(ps, names[k], sw, 1024);
+        double u = uncertainty(ps, names[k]);
         for (int t = 0; t < 3; t++) {
             const sa_point *a = find(ps, names[k], "auto", TOLS[t]), *best = NULL;
-            char s1[128] = "—";
+            char s1[160] = "—";
+            const char *verdict = "—";
             for (size_t i = 0; i < n && !best; i++)
-                if (sw[i]->err.rmse <= TOLS[t])
+                if (meets(sw[i]->err.rmse, u, TOLS[t]))
                     best = sw[i];
             if (best)
                 setting(s1, sizeof s1, best);
-            fprintf(f, "| %s | %g | %s | %.2g | %.3g | %s | %.2g | %.3g | %.2f | %.2f |\n",
-                    names[k], TOLS[t], a ? a->note : "—", a ? a->err.rmse : NAN,
+            else if (!(u < TOLS[t]))
+                snprintf(s1, sizeof s1, "none: E ≤ U = %.2g", u);
+            if (a)
+                verdict = meets(a->err.rmse, u, TOLS[t])     ? "yes"
+                          : a->err.rmse - u > TOLS[t]        ? "**no**"
+                                                             : "unresolved";
+            fprintf(f, "| %s | %g | %s | %.2g | %s | %.3g | %s | %.2g | %.3g | %.2f | %.2f |\n",
+                    names[k], TOLS[t], a ? a->note : "—", a ? a->err.rmse : NAN, verdict,
                     a ? a->seconds : NAN, s1, best ? best->err.rmse : NAN,
                     best ? best->seconds : NAN, a && best ? a->seconds / best->seconds : NAN,
                     a && dflt ? a->seconds / dflt->seconds : NAN);
         }
     }
     fputs("\n## The references and POV-Ray\n\n"
-          "| scene | reference | its last doubling | default polarized: rmse, s | POV-Ray: rmse, "
-          "largest, share > 1/255, s |\n|---|---|---|---|---|\n", f);
+          "| scene | reference | U | how far it converged | default polarized: rmse, s "
+          "| POV-Ray: rmse, largest, share > 1/255, s |\n|---|---|---|---|---|---|\n", f);
     for (size_t k = 0; k < ns; k++) {
         const sa_point *r = find(ps, names[k], "reference", 0.0);
         const sa_point *d = find(ps, names[k], "default", 0.0);
         const sa_point *p = find(ps, names[k], "povray", 0.0);
         fprintf(f, "| %s | ", names[k]);
         if (r)
-            fprintf(f, "%d wl, depth %d | %s | ", r->wavelengths, r->depth, r->note);
+            fprintf(f, "%d wl, depth %d, cut-off %g | %.2g | %s | ", r->wavelengths, r->depth,
+                    r->cutoff, r->err.rmse, r->note);
         else
-            fputs("— | — | ", f);
+            fputs("— | — | — | ", f);
         if (d)
             fprintf(f, "%.2g, %.3g | ", d->err.rmse, d->seconds);
         else

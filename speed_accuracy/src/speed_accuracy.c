@@ -35,7 +35,8 @@
 static const char *const usage_text[] = {
 "usage: speed_accuracy [--bin DIR] [--scenes DIR] [--docs DIR] [--work DIR]\n"
 "                      [--width W] [--height H] [--runs K] [--scene NAME]...\n"
-"                      [--max-wavelengths N] [--reuse-references]\n"
+"                      [--max-wavelengths N] [--reference-seconds S]\n"
+"                      [--point-seconds S] [--reuse-references]\n"
 "       speed_accuracy --chart-only [--docs DIR]\n"
 "       speed_accuracy --help\n"
 "\n"
@@ -46,17 +47,23 @@ static const char *const usage_text[] = {
 "\n",
 "  --bin DIR        where lensrender and pov_compare are (default build/bin)\n"
 "  --work DIR       references and renders (default build/speed-accuracy)\n"
-"  --width W, --height H   image size of every render (default 32 x 24)\n"
+"  --width W, --height H   image size of every render (default 16 x 12)\n"
 "  --runs K         timed runs per setting; its time is their median\n"
-"                   (default 3; a setting slower than 5 s runs once)\n"
+"                   (default 3; a setting slower than 1 s runs once)\n"
 "  --scene NAME     only this scene (repeatable; default every *.scene)\n"
-"  --max-wavelengths N   the reference's wavelength cap, <= 1024 (default 1024)\n"
+"  --max-wavelengths N   the reference's wavelength cap, <= 16384 (default 16384)\n"
+"  --reference-seconds S   no reference doubling predicted (2.5 x the last\n"
+"                   render) to take longer than S CPU seconds (default 45)\n"
+"  --point-seconds S   no swept setting predicted (from the reference's time\n"
+"                   per wavelength) to take longer than S (default 10)\n"
 "  --reuse-references    keep references already in the work directory\n"
 "  --references-only     make the references and stop\n"
 "\n"
-"REFERENCE: polarized, no cut-off, wavelengths from 64 and depth from 16,\n"
-"each doubled while doubling it changes some pixel by more than 1e-5 (up\n"
-"to the cap, and depth 64).  ERROR: RMSE of linear RGB against it, the\n"
+"REFERENCE: polarized; at 128 wavelengths the depth doubled from 16 (to 64)\n"
+"and the cut-off divided by 100 from 1e-10 (to 1e-14) while that changes\n"
+"some pixel by more than 1e-5; then the wavelengths doubled from 128 while\n"
+"that does (to the cap and the time budget).  Its uncertainty U: the RMSE\n"
+"changes of the three last steps, summed.  ERROR: RMSE of linear RGB against it, the\n"
 "largest channel difference, and the share of pixels with a channel off\n"
 "by more than 1/255 after the sRGB curve.  TIME: CPU seconds of the\n"
 "lensrender (or povray) process, --threads 1.\n"
@@ -70,6 +77,8 @@ static const char *const usage_text[] = {
 typedef struct opts {
     const char *bin, *scenes, *docs, *work;
     int width, height, runs, max_wavelengths, reuse, chart_only, references_only;
+    double reference_seconds; /* a reference doubling predicted slower is not run */
+    double point_seconds;     /* a swept setting predicted slower is not run */
     int rank; /* this process's, in a run across processes (names its renders) */
     const char *only[64];
     int n_only;
@@ -104,7 +113,13 @@ typedef struct scene_ctx {
     char dir[PATH_MAX_LEN]; /* its work directory */
     rs_image ref;
     int ref_wavelengths, ref_depth;
-    double ref_dn_max, ref_dd_max, ref_dn_rmse; /* last doubling changes */
+    double ref_cutoff;
+    /* The changes of the last doubling of the wavelengths (dn), of the
+     * depth (dd) and of the cut-off divided by 100 (dc): largest pixel
+     * channel and RMSE.  ref_u, their RMSE summed, bounds the reference's
+     * own error (see make_reference). */
+    double ref_dn_max, ref_dn_rmse, ref_dd_max, ref_dd_rmse, ref_dc_max, ref_dc_rmse, ref_u;
+    double ref_s_per_wl; /* CPU seconds per wavelength of the reference's render */
 } scene_ctx;
 
 /* Render the setting p once or several times; fills p->seconds and, when
@@ -186,7 +201,7 @@ static int render(const scene_ctx *sc, sa_point *p, int runs, rs_image *img)
                 p->note[k] = '\0';
             }
         }
-        if (r == 0 && runs > 1 && res.cpu_seconds > 5.0) {
+        if (r == 0 && runs > 1 && res.cpu_seconds > 1.0) {
             runs = 1;
             break;
         }
@@ -211,10 +226,34 @@ static double max_abs_diff(const rs_image *a, const rs_image *b)
 
 /* ---- the converged reference -------------------------------------------- */
 
+/* Polarized, always.  Depth and cut-off are settled at REF_WAVELENGTHS0
+ * (the branch tree does not depend on the wavelength count): the depth is
+ * doubled from REF_DEPTH0 while that changes some pixel by more than
+ * REF_TOL (to REF_DEPTH_MAX), then the cut-off divided by 100 from
+ * REF_CUTOFF0 while that does (to REF_CUTOFF_MIN).  A cut-off and not
+ * none: a branch below 1e-10 of the light cannot change a pixel by more
+ * than 1e-10 of the brightest radiance (2e-5 through interference, the
+ * amplitude's square root times two), and without one a birefringent
+ * plate's tree doubles at every bounce (conoscope at depth 16: 70 CPU s at
+ * 16 x 12 and 64 wavelengths against 4 s with it).  Then the wavelengths
+ * are doubled while the doubling changes some pixel by more than REF_TOL,
+ * up to --max-wavelengths, or until the next doubling is predicted (2.5
+ * times the last render) to take more than --reference-seconds.
+ *
+ * The midpoint rule over wavelength has a step wherever a pixel's path
+ * changes with the wavelength (a dispersed ray crossing a checker edge or
+ * a rim), so its error falls as 1/N: the last doubling's change is about
+ * the coarser render's error and twice the finer one's.  ref_u, the RMSE
+ * of the three last changes summed, therefore bounds the reference's own
+ * RMSE from the truth; an error measured against it is known to +- ref_u
+ * (the triangle inequality), and the page says a setting meets E only
+ * when its error plus ref_u is at most E. */
 #define REF_TOL 1e-5
 #define REF_DEPTH0 16
 #define REF_DEPTH_MAX 64
-#define REF_WAVELENGTHS0 64
+#define REF_WAVELENGTHS0 128
+#define REF_CUTOFF0 1e-10
+#define REF_CUTOFF_MIN 1e-14
 
 static int save_reference(scene_ctx *sc)
 {
@@ -229,8 +268,10 @@ static int save_reference(scene_ctx *sc)
     f = fopen(path, "w");
     if (!f)
         return -1;
-    fprintf(f, "%d %d %d %d %.9g %.9g %.9g\n", sc->o->width, sc->o->height, sc->ref_wavelengths,
-            sc->ref_depth, sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max);
+    fprintf(f, "%d %d %d %d %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", sc->o->width,
+            sc->o->height, sc->ref_wavelengths, sc->ref_depth, sc->ref_cutoff, sc->ref_dn_max,
+            sc->ref_dn_rmse, sc->ref_dd_max, sc->ref_dd_rmse, sc->ref_dc_max, sc->ref_dc_rmse,
+            sc->ref_u, sc->ref_s_per_wl);
     return fclose(f) == 0 ? 0 : -1;
 }
 
@@ -243,8 +284,10 @@ static int load_reference(scene_ctx *sc)
     f = fopen(path, "r");
     if (!f)
         return -1;
-    int ok = fscanf(f, "%d %d %d %d %lg %lg %lg", &w, &h, &sc->ref_wavelengths, &sc->ref_depth,
-                    &sc->ref_dn_max, &sc->ref_dn_rmse, &sc->ref_dd_max) == 7;
+    int ok = fscanf(f, "%d %d %d %d %lg %lg %lg %lg %lg %lg %lg %lg %lg", &w, &h,
+                    &sc->ref_wavelengths, &sc->ref_depth, &sc->ref_cutoff, &sc->ref_dn_max,
+                    &sc->ref_dn_rmse, &sc->ref_dd_max, &sc->ref_dd_rmse, &sc->ref_dc_max,
+                    &sc->ref_dc_rmse, &sc->ref_u, &sc->ref_s_per_wl) == 13;
     fclose(f);
     if (!ok || w != sc->o->width || h != sc->o->height)
         return -1;
@@ -252,54 +295,76 @@ static int load_reference(scene_ctx *sc)
     return rs_pfm_read(path, &sc->ref, msg, sizeof msg);
 }
 
+/* Render (n, d, c) into *next and measure its change from *base; *base
+ * becomes *next.  Returns 0, or -1. */
+static int ref_step(scene_ctx *sc, int n, int d, double c, rs_image *base, double *max,
+                    double *rmse, double *seconds)
+{
+    sa_point p;
+    rs_image next;
+    memset(&next, 0, sizeof next);
+    sa_point_init(&p, "reference", "polarized", n, d, c);
+    if (render(sc, &p, 1, &next) != 0)
+        return -1;
+    *max = max_abs_diff(&next, base);
+    *rmse = rs_image_rmse(&next, base);
+    *seconds = p.seconds;
+    rs_image_free(base);
+    *base = next;
+    return 0;
+}
+
 static int make_reference(scene_ctx *sc)
 {
     sa_point p;
-    rs_image base, more_n, more_d;
+    rs_image base;
     int n = REF_WAVELENGTHS0, d = REF_DEPTH0;
-    int n_done = 0, d_done = 0;
+    double c = REF_CUTOFF0, seconds;
 
     if (sc->o->reuse && load_reference(sc) == 0) {
         fprintf(stderr, "speed_accuracy: %s: reference reused (%d wavelengths, depth %d)\n",
                 sc->name, sc->ref_wavelengths, sc->ref_depth);
         return 0;
     }
+    if (2 * n > sc->o->max_wavelengths) /* room for one doubling */
+        n = sc->o->max_wavelengths > 1 ? sc->o->max_wavelengths / 2 : 1;
     memset(&base, 0, sizeof base);
-    sa_point_init(&p, "reference", "polarized", n, d, 0.0);
+    sa_point_init(&p, "reference", "polarized", n, d, c);
     if (render(sc, &p, 1, &base) != 0)
         return -1;
-    while (!(n_done && d_done)) {
-        if (!n_done) {
-            memset(&more_n, 0, sizeof more_n);
-            sa_point_init(&p, "reference", "polarized", 2 * n, d, 0.0);
-            if (render(sc, &p, 1, &more_n) != 0)
-                return -1;
-            sc->ref_dn_max = max_abs_diff(&more_n, &base);
-            sc->ref_dn_rmse = rs_image_rmse(&more_n, &base);
-            fprintf(stderr, "speed_accuracy: %s: wavelengths %d -> %d: max change %.3g, rmse %.3g\n",
-                    sc->name, n, 2 * n, sc->ref_dn_max, sc->ref_dn_rmse);
-            rs_image_free(&base);
-            base = more_n;
-            n *= 2;
-            n_done = sc->ref_dn_max <= REF_TOL || 2 * n > sc->o->max_wavelengths;
-        }
-        if (!d_done) {
-            memset(&more_d, 0, sizeof more_d);
-            sa_point_init(&p, "reference", "polarized", n, 2 * d, 0.0);
-            if (render(sc, &p, 1, &more_d) != 0)
-                return -1;
-            sc->ref_dd_max = max_abs_diff(&more_d, &base);
-            fprintf(stderr, "speed_accuracy: %s: depth %d -> %d: max change %.3g\n", sc->name, d,
-                    2 * d, sc->ref_dd_max);
-            rs_image_free(&base);
-            base = more_d;
-            d *= 2;
-            d_done = sc->ref_dd_max <= REF_TOL || 2 * d > REF_DEPTH_MAX;
-        }
+    seconds = p.seconds;
+    do {
+        if (ref_step(sc, n, 2 * d, c, &base, &sc->ref_dd_max, &sc->ref_dd_rmse, &seconds) != 0)
+            return -1;
+        fprintf(stderr, "speed_accuracy: %s: depth %d -> %d: max change %.3g, rmse %.3g\n",
+                sc->name, d, 2 * d, sc->ref_dd_max, sc->ref_dd_rmse);
+        d *= 2;
+    } while (sc->ref_dd_max > REF_TOL && 2 * d <= REF_DEPTH_MAX);
+    do {
+        if (ref_step(sc, n, d, c / 100.0, &base, &sc->ref_dc_max, &sc->ref_dc_rmse, &seconds) !=
+            0)
+            return -1;
+        fprintf(stderr, "speed_accuracy: %s: cut-off %.3g -> %.3g: max change %.3g, rmse %.3g\n",
+                sc->name, c, c / 100.0, sc->ref_dc_max, sc->ref_dc_rmse);
+        c /= 100.0;
+    } while (sc->ref_dc_max > REF_TOL && c / 100.0 > 0.5 * REF_CUTOFF_MIN);
+    sc->ref_dn_max = sc->ref_dn_rmse = INFINITY;
+    while (2 * n <= sc->o->max_wavelengths && 2.5 * seconds <= sc->o->reference_seconds) {
+        if (ref_step(sc, 2 * n, d, c, &base, &sc->ref_dn_max, &sc->ref_dn_rmse, &seconds) != 0)
+            return -1;
+        fprintf(stderr,
+                "speed_accuracy: %s: wavelengths %d -> %d: max change %.3g, rmse %.3g (%.3g s)\n",
+                sc->name, n, 2 * n, sc->ref_dn_max, sc->ref_dn_rmse, seconds);
+        n *= 2;
+        if (sc->ref_dn_max <= REF_TOL)
+            break;
     }
     sc->ref = base;
     sc->ref_wavelengths = n;
     sc->ref_depth = d;
+    sc->ref_cutoff = c;
+    sc->ref_u = sc->ref_dn_rmse + sc->ref_dd_rmse + sc->ref_dc_rmse;
+    sc->ref_s_per_wl = seconds / n;
     return 0; /* saved by the process that gathers (reference_done) */
 }
 
@@ -358,7 +423,9 @@ static int povray_point(const scene_ctx *sc, sa_point *p, rs_image *img)
 static const char *const MODELS[] = {"polarized", "fresnel", "schlick", "rgb"};
 static const int WAVELENGTHS[] = {4, 8, 16, 32, 64, 128, 256, 512};
 static const int DEPTHS[] = {4, 8, 16};
-static const double CUTOFFS[] = {0.0, 1e-3, -1.0}; /* -1: the scene's adc_bailout */
+/* 1e-6, not 0: without a cut-off a birefringent plate's tree doubles at
+ * every bounce (see the reference); 1e-6 of the light is below every E. */
+static const double CUTOFFS[] = {1e-6, 1e-3, -1.0}; /* -1: the scene's adc_bailout */
 static const double TOLERANCES[] = {1e-2, 1e-3, 1e-4};
 
 #define N_OF(a) (sizeof(a) / sizeof *(a))
@@ -407,8 +474,7 @@ typedef struct sweep {
 typedef struct item_head {
     int width, height; /* 0 x 0: no image (a point that could not run) */
     sa_point p;        /* a point's numbers */
-    int ref_wavelengths, ref_depth; /* a reference's */
-    double ref_dn_max, ref_dd_max, ref_dn_rmse;
+    scene_ctx ref; /* a reference's numbers (not its image) */
 } item_head;
 
 static int add_point(sweep *w, int scene, const sa_point *p)
@@ -447,6 +513,10 @@ static int list_points(sweep *w, int k)
             for (size_t d = 0; d < N_OF(DEPTHS); d++)
                 for (size_t c = 0; c < N_OF(CUTOFFS); c++) {
                     if (!in_sweep((int)m, (int)wl, (int)d, (int)c))
+                        continue;
+                    /* Predicted from the reference's time per wavelength
+                     * (deeper, a lower cut-off, polarized: an upper bound). */
+                    if (m != 3 && WAVELENGTHS[wl] * w->sc[k].ref_s_per_wl > w->o->point_seconds)
                         continue;
                     sa_point_init(&p, "sweep", MODELS[m], m == 3 ? 0 : WAVELENGTHS[wl],
                                   DEPTHS[d], CUTOFFS[c]);
@@ -503,11 +573,9 @@ static int reference_run(void *user, long k, void *result, size_t *used, char *m
     if (make_reference(sc) != 0)
         return 1;
     memset(&h, 0, sizeof h);
-    h.ref_wavelengths = sc->ref_wavelengths;
-    h.ref_depth = sc->ref_depth;
-    h.ref_dn_max = sc->ref_dn_max;
-    h.ref_dd_max = sc->ref_dd_max;
-    h.ref_dn_rmse = sc->ref_dn_rmse;
+    h.ref = *sc;
+    h.ref.o = NULL;
+    memset(&h.ref.ref, 0, sizeof h.ref.ref);
     pack(&h, &sc->ref, result, used, w->o);
     rs_image_free(&sc->ref); /* rank 0 gets it back in reference_done */
     return 0;
@@ -520,11 +588,17 @@ static void reference_done(void *user, long k, const void *result, size_t size)
     item_head h;
     rs_image img = unpack(result, &h);
     (void)size;
-    sc->ref_wavelengths = h.ref_wavelengths;
-    sc->ref_depth = h.ref_depth;
-    sc->ref_dn_max = h.ref_dn_max;
-    sc->ref_dd_max = h.ref_dd_max;
-    sc->ref_dn_rmse = h.ref_dn_rmse;
+    sc->ref_wavelengths = h.ref.ref_wavelengths;
+    sc->ref_depth = h.ref.ref_depth;
+    sc->ref_cutoff = h.ref.ref_cutoff;
+    sc->ref_dn_max = h.ref.ref_dn_max;
+    sc->ref_dn_rmse = h.ref.ref_dn_rmse;
+    sc->ref_dd_max = h.ref.ref_dd_max;
+    sc->ref_dd_rmse = h.ref.ref_dd_rmse;
+    sc->ref_dc_max = h.ref.ref_dc_max;
+    sc->ref_dc_rmse = h.ref.ref_dc_rmse;
+    sc->ref_u = h.ref.ref_u;
+    sc->ref_s_per_wl = h.ref.ref_s_per_wl;
     rs_image_free(&sc->ref);
     if (!img.rgb || rs_image_create(&sc->ref, img.width, img.height) != 0) {
         say("%s: the reference is lost (out of memory)%s", sc->name, "");
@@ -585,10 +659,19 @@ static int write_table(const sweep *w, FILE *csv, sa_points *all)
     for (int s = 0; s < w->n_sc; s++) {
         const scene_ctx *sc = &w->sc[s];
         sa_point p;
-        sa_point_init(&p, "reference", "polarized", sc->ref_wavelengths, sc->ref_depth, 0.0);
+        sa_point_init(&p, "reference", "polarized", sc->ref_wavelengths, sc->ref_depth,
+                      sc->ref_cutoff);
         snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
-        snprintf(p.note, sizeof p.note, "doubling wavelengths: max %.3g rmse %.3g; depth: max %.3g",
-                 sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max);
+        snprintf(p.note, sizeof p.note,
+                 "%d x %d pixels; last doubling of the wavelengths: max %.2g rmse %.2g; of the "
+                 "depth: max %.2g rmse %.2g; cut-off / 100: max %.2g rmse %.2g",
+                 w->o->width, w->o->height, sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max, sc->ref_dd_rmse,
+                 sc->ref_dc_max, sc->ref_dc_rmse);
+        /* A reference's error columns: its own uncertainty (rmse: ref_u;
+         * max_abs: the last wavelength doubling's largest change). */
+        p.err.rmse = sc->ref_u;
+        p.err.max_abs = sc->ref_dn_max;
+        p.err.share_visible = NAN;
         p.seconds = NAN;
         if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
             return -1;
@@ -659,10 +742,12 @@ static int parse(opts *o, int argc, char **argv)
     o->scenes = "scenes";
     o->docs = "docs";
     o->work = "build/speed-accuracy";
-    o->width = 32;
-    o->height = 24;
+    o->width = 16;
+    o->height = 12;
     o->runs = 3;
-    o->max_wavelengths = 1024;
+    o->max_wavelengths = 16384;
+    o->reference_seconds = 45.0;
+    o->point_seconds = 10.0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -687,6 +772,15 @@ static int parse(opts *o, int argc, char **argv)
             o->docs = v, i++;
         } else if (strcmp(a, "--work") == 0) {
             o->work = v, i++;
+        } else if (strcmp(a, "--reference-seconds") == 0 || strcmp(a, "--point-seconds") == 0) {
+            char *end;
+            double x = strtod(v, &end);
+            if (end == v || *end || !(x > 0.0 && x <= 1e6)) {
+                say("%s: '%s' is out of range", a, v);
+                return -1;
+            }
+            *(a[2] == 'r' ? &o->reference_seconds : &o->point_seconds) = x;
+            i++;
         } else if (strcmp(a, "--scene") == 0) {
             if (o->n_only == (int)N_OF(o->only)) {
                 say("too many --scene%s%s", "", "");
@@ -697,7 +791,7 @@ static int parse(opts *o, int argc, char **argv)
                    strcmp(a, "--runs") == 0 || strcmp(a, "--max-wavelengths") == 0) {
             int *dst = a[2] == 'w' ? &o->width : a[2] == 'h' ? &o->height
                        : a[2] == 'r' ? &o->runs : &o->max_wavelengths;
-            if (int_arg(v, 1, a[2] == 'r' ? 15 : a[2] == 'm' ? 1024 : 16384, dst) != 0) {
+            if (int_arg(v, 1, a[2] == 'r' ? 15 : 16384, dst) != 0) {
                 say("%s: '%s' is out of range", a, v);
                 return -1;
             }

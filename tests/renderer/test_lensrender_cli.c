@@ -14,8 +14,8 @@
  *     broken scene aimed at the same paths, and after a run that cannot
  *     write its PFM (exit 1);
  *   - --threads 1, 2, 3, 7 and 64 give the same bytes;
- *   - --wavelengths over 1..1024: a directly seen emitter renders as its
- *     RGB (0 and 1025 refused);
+ *   - --wavelengths over 1..16384: a directly seen emitter renders as its
+ *     RGB (0 and 16385 refused);
  *   - --depth and --cutoff change a plate's transmission as the series of
  *     its internal reflections says;
  *   - the progress line on a terminal (a pseudo-terminal), none with
@@ -498,7 +498,7 @@ static int render_text(const char *dir, const char *text, int w, int h, const ch
  * value may be off by after the doubles are rounded. */
 #define FLOAT_TOL 1.2e-7
 
-/* --wavelengths takes 1..1024 (args.h, --help).  A directly seen RGB
+/* --wavelengths takes 1..16384 (args.h, --help).  A directly seen RGB
  * emitter renders as exactly its RGB whatever the count >= 3 (the colour
  * correction; test_spectrum checks its rounding), and with 1 or 2
  * wavelengths as grey (luminance only; white as 1): checked over the
@@ -506,7 +506,7 @@ static int render_text(const char *dir, const char *text, int w, int h, const ch
 static void test_wavelength_counts(void)
 {
     char dir[4096], text[256];
-    static const char *const counts[] = {"1", "2", "3", "5", "16", "100", "1024"};
+    static const char *const counts[] = {"1", "2", "3", "5", "16", "100", "1024", "16384"};
     static const double cols[2][3] = {{1, 1, 1}, {0.8, 0.3, 0.1}};
     fresh_dir(dir, sizeof dir, "wavelengths");
     for (size_t k = 0; k < sizeof counts / sizeof *counts; k++)
@@ -532,7 +532,7 @@ static void test_wavelength_counts(void)
                           "--wavelengths %s: emitter (%g %g %g) channel %d", counts[k],
                           cols[c][0], cols[c][1], cols[c][2], ch);
         }
-    static const char *const bad[] = {"0", "1025"};
+    static const char *const bad[] = {"0", "16385"};
     for (size_t k = 0; k < 2; k++) {
         const char *a[] = {DEFAULT_SCENE, "--wavelengths", bad[k], "--quiet", NULL};
         proc p = run_argv(a);

@@ -210,7 +210,7 @@ const char *lr_mode_name(lr_mode mode);
 #define LR_SIZE_MAX 16384            /* width, height */
 #define LR_PIXELS_MAX (64LL * 1024 * 1024) /* width * height */
 #define LR_DEPTH_MAX 256
-#define LR_WAVELENGTHS_MAX 1024
+#define LR_WAVELENGTHS_MAX 16384
 #define LR_AA_MAX 16
 #define LR_THREADS_MAX 1024
 
