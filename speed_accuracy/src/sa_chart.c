@@ -239,7 +239,7 @@ static int write_png(const sa_points *ps, const char **names, size_t ns, const c
         pl_text(&img, x + 260, y + 30, 2, TOL_COLOR[1], "<> auto, E = 1e-3");
         pl_text(&img, x + 520, y + 30, 2, TOL_COLOR[2], "<> auto, E = 1e-4");
         pl_text(&img, x + 820, y + 30, 2, 0x606060u, "dotted: the three E");
-        pl_text(&img, x + 820, y, 2, UNCERTAIN_COLOR, "dashed: the reference's U");
+        pl_text(&img, x + 1100, y, 2, UNCERTAIN_COLOR, "dashed: the reference's U");
         snprintf(path, sizeof path, "%s/speed-accuracy.png", dir);
         rc = rs_png_write(path, &img, msg, msg_size);
     }
