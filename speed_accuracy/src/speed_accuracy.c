@@ -11,6 +11,7 @@
 #define _POSIX_C_SOURCE 200809L
 
 #include <errno.h>
+#include <signal.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -123,10 +124,11 @@ typedef struct scene_ctx {
     int ref_dn_cheap;    /* the wavelength doubling was measured there */
 } scene_ctx;
 
-/* Render the setting p once or several times; fills p->seconds and, when
- * img is not NULL, reads the image into *img.  Returns 0, or -1 with a
- * message on stderr. */
-static int render(const scene_ctx *sc, sa_point *p, int runs, rs_image *img)
+/* Render the setting p once or several times, each run with at most
+ * cpu_limit CPU seconds (<= 0: no limit); fills p->seconds and, when img
+ * is not NULL, reads the image into *img.  Returns 0; 1 when the render
+ * ran out of its CPU time (left out); or -1 with a message on stderr. */
+static int render(const scene_ctx *sc, sa_point *p, int runs, double cpu_limit, rs_image *img)
 {
     char pfm[PATH_BUF], png[PATH_BUF], exe[PATH_BUF];
     char w[16], h[16], nl[16], dp[16], cut[32], tol[32], msg[512];
@@ -181,9 +183,15 @@ static int render(const scene_ctx *sc, sa_point *p, int runs, rs_image *img)
         runs = 16;
     for (int r = 0; r < runs; r++) {
         sa_run_result res;
-        if (sa_run(argv, NULL, &res, msg, sizeof msg) != 0) {
+        if (sa_run(argv, NULL, cpu_limit, &res, msg, sizeof msg) != 0) {
             say("%s: %s", exe, msg);
             return -1;
+        }
+        if (cpu_limit > 0.0 && res.status == 128 + SIGXCPU) {
+            fprintf(stderr, "speed_accuracy: %s: %s %d wl depth %d cut-off %g: over %g CPU s, "
+                    "left out\n", sc->name, p->model, p->wavelengths, p->depth, p->cutoff,
+                    cpu_limit);
+            return 1;
         }
         if (res.status != 0) {
             say("%s failed: %s", sc->path, res.err);
@@ -308,7 +316,7 @@ static int ref_step(scene_ctx *sc, int n, int d, double c, rs_image *base, doubl
     rs_image next;
     memset(&next, 0, sizeof next);
     sa_point_init(&p, "reference", "polarized", n, d, c);
-    if (render(sc, &p, 1, &next) != 0)
+    if (render(sc, &p, 1, 0.0, &next) != 0)
         return -1;
     *max = max_abs_diff(&next, base);
     *rmse = rs_image_rmse(&next, base);
@@ -334,7 +342,7 @@ static int make_reference(scene_ctx *sc)
         n = sc->o->max_wavelengths > 1 ? sc->o->max_wavelengths / 2 : 1;
     memset(&base, 0, sizeof base);
     sa_point_init(&p, "reference", "polarized", n, d, c);
-    if (render(sc, &p, 1, &base) != 0)
+    if (render(sc, &p, 1, 0.0, &base) != 0)
         return -1;
     seconds = p.seconds;
     do {
@@ -359,7 +367,7 @@ static int make_reference(scene_ctx *sc)
         double cheap_s, dmax, drmse;
         memset(&cheap, 0, sizeof cheap);
         sa_point_init(&p, "reference", "polarized", n, CHEAP_DEPTH, CHEAP_CUTOFF);
-        if (render(sc, &p, 1, &cheap) != 0)
+        if (render(sc, &p, 1, 0.0, &cheap) != 0)
             return -1;
         cheap_s = p.seconds;
         sc->ref_s_per_wl = cheap_s / n;
@@ -425,7 +433,7 @@ static int povray_point(const scene_ctx *sc, sa_point *p, rs_image *img)
     {
         char *argv[] = {exe, (char *)sc->path, "--out", out, "--width", w, "--height", h,
                         "--threads", "1", "--quiet", NULL};
-        if (sa_run(argv, NULL, &res, msg, sizeof msg) != 0 || res.status != 0) {
+        if (sa_run(argv, NULL, 0.0, &res, msg, sizeof msg) != 0 || res.status != 0) {
             say("%s: pov_compare failed: %s", sc->name, res.err);
             return -1;
         }
@@ -435,7 +443,7 @@ static int povray_point(const scene_ctx *sc, sa_point *p, rs_image *img)
     char *argv[] = {"povray", "-D", "-V", "-GS", "-GR", "+Iscene.pov", "+Opoint.png", a_w, a_h,
                     "-A", "+Q9", "-UA", "+FN16", "File_Gamma=1.0", "Dither=off", "+WT1", NULL};
     for (int r = 0; r < runs; r++) {
-        if (sa_run(argv, out, &res, msg, sizeof msg) != 0 || res.status != 0) {
+        if (sa_run(argv, out, 0.0, &res, msg, sizeof msg) != 0 || res.status != 0) {
             say("%s: povray failed: %s", sc->name, res.err);
             return -1;
         }
@@ -663,7 +671,17 @@ static int point_run(void *user, long k, void *result, size_t *used, char *msg,
         snprintf(h.p.scene, sizeof h.p.scene, "%s", jp->p.scene);
         rc = 0;
     } else {
-        rc = render(&w->sc[jp->scene], &h.p, w->o->runs, &img);
+        /* A swept point that runs out of 4 x --point-seconds is left out (no
+         * image): the time predicted from the cheap render does not know
+         * a scene's own cut-off of 0 on a birefringent tree. */
+        rc = render(&w->sc[jp->scene], &h.p, w->o->runs,
+                    strcmp(h.p.kind, "sweep") == 0 ? 4.0 * w->o->point_seconds : 0.0, &img);
+        if (rc == 1) {
+            memset(&h.p.err, 0, sizeof h.p.err);
+            rc = 0;
+            rs_image_free(&img);
+            img.rgb = NULL;
+        }
     }
     if (rc == 0)
         pack(&h, &img, result, used, w->o);
