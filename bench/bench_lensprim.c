@@ -2,15 +2,20 @@
  *
  * A benchmark, not a test: it traces random rays through the default lens
  * (biconvex N-BK7, R 50/-50, t 8, D 25) in each mode and depth, forward
- * (one call per ray and the batch entry point) and backward (build +
+ * (one call per ray, lp_trace_forward_many, and lp_trace_forward_soa on
+ * groups of 64 rays, each group at one wavelength) and backward (build +
  * gather of a one-ray bundle per query), on one thread, and prints
  * nodes/s and the time ratio of each mode to polarized measured in the
- * same run.  Usage: bench_lensprim [rays] (default 200000). */
+ * same run.  Usage:
+ *     bench_lensprim [RAYS] [--mode polarized|fresnel|schlick] [--depth N]
+ * RAYS defaults to 200000; --mode and --depth keep one row each (for a
+ * profiler); without them every mode at depths 2, 5 and 20 is printed. */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include <time.h>
 
 #include "lensprim.h"
@@ -51,12 +56,38 @@ static void random_ray(lp_ray *r)
 
 int main(int argc, char **argv)
 {
-    size_t n = argc > 1 ? strtoul(argv[1], NULL, 10) : 200000;
+    size_t n = 200000;
+    int only_mode = -1, only_depth = 0;
     lp_lens_desc desc;
     lp_lens *lens;
     lp_error err;
     const char *mode_name[] = {"polarized", "fresnel", "schlick"};
     const int depths[] = {2, 5, 20};
+
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--mode") == 0 && i + 1 < argc) {
+            i++;
+            for (int m = 0; m < 3; m++)
+                if (strcmp(argv[i], mode_name[m]) == 0)
+                    only_mode = m;
+            if (only_mode < 0) {
+                fprintf(stderr, "bench: unknown mode %s\n", argv[i]);
+                return 2;
+            }
+        } else if (strcmp(argv[i], "--depth") == 0 && i + 1 < argc) {
+            only_depth = atoi(argv[++i]);
+            if (only_depth < 1 || only_depth > LP_MAX_DEPTH) {
+                fprintf(stderr, "bench: depth must be in 1..%d\n", LP_MAX_DEPTH);
+                return 2;
+            }
+        } else if (argv[i][0] != '-' && strtoul(argv[i], NULL, 10) > 0) {
+            n = strtoul(argv[i], NULL, 10);
+        } else {
+            fprintf(stderr, "usage: bench_lensprim [RAYS] [--mode M] [--depth N]\n");
+            return 2;
+        }
+    }
+    int n_depths = only_depth ? 1 : (int)(sizeof depths / sizeof depths[0]);
 
     lp_lens_desc_init(&desc);
     desc.radius1 = 50;
@@ -74,6 +105,20 @@ int main(int argc, char **argv)
         return 1;
     for (size_t i = 0; i < n; i++)
         random_ray(&rays[i]);
+    /* the same rays as arrays for lp_trace_forward_soa */
+    const size_t soa_group = 64;
+    double *soa = malloc(10 * n * sizeof *soa);
+    if (!soa)
+        return 1;
+    double *sox = soa, *soy = soa + n, *soz = soa + 2 * n, *sdx = soa + 3 * n,
+           *sdy = soa + 4 * n, *sdz = soa + 5 * n, *svx = soa + 6 * n, *svy = soa + 7 * n,
+           *svz = soa + 8 * n, *sin_ = soa + 9 * n;
+    for (size_t i = 0; i < n; i++) {
+        sox[i] = rays[i].origin.x, soy[i] = rays[i].origin.y, soz[i] = rays[i].origin.z;
+        sdx[i] = rays[i].dir.x, sdy[i] = rays[i].dir.y, sdz[i] = rays[i].dir.z;
+        svx[i] = rays[i].vp.x, svy[i] = rays[i].vp.y, svz[i] = rays[i].vp.z;
+        sin_[i] = rays[i].intensity;
+    }
 
     lp_result res;
     lp_result_init(&res);
@@ -81,15 +126,17 @@ int main(int argc, char **argv)
     lp_backward_create(&bw, &err);
 
     printf("%zu rays, one thread\n", n);
-    printf("%-10s %5s %14s %14s %14s %10s\n", "mode", "depth", "fwd nodes/s", "batch nodes/s",
-           "bwd nodes/s", "fwd t/pol");
-    for (size_t di = 0; di < sizeof depths / sizeof depths[0]; di++) {
+    printf("%-10s %5s %14s %14s %14s %14s %10s\n", "mode", "depth", "fwd nodes/s",
+           "batch nodes/s", "soa nodes/s", "bwd nodes/s", "fwd t/pol");
+    for (int di = 0; di < n_depths; di++) {
         double t_pol = 0.0;
         for (int m = 0; m < 3; m++) {
+            if (only_mode >= 0 && m != only_mode)
+                continue;
             lp_trace_args a;
             lp_trace_args_init(&a);
             a.mode = (lp_mode)m;
-            a.max_depth = depths[di];
+            a.max_depth = only_depth ? only_depth : depths[di];
 
             size_t nodes = 0;
             double t0 = now();
@@ -103,6 +150,19 @@ int main(int argc, char **argv)
             lp_trace_forward_many(lens, rays, n, &a, &res, offsets, NULL);
             double t_batch = now() - t0;
             size_t batch_nodes = res.nodes;
+
+            /* the arrays entry point, one wavelength per call: the rays in
+             * groups of soa_group, each group at its first ray's lambda */
+            size_t soa_nodes = 0;
+            t0 = now();
+            for (size_t i = 0; i < n; i += soa_group) {
+                size_t m = n - i < soa_group ? n - i : soa_group;
+                lp_ray_soa s = {sox + i, soy + i, soz + i, sdx + i, sdy + i, sdz + i, svx + i,
+                                svy + i, svz + i, sin_ + i, NULL, NULL, NULL, NULL};
+                lp_trace_forward_soa(lens, rays[i].lambda_nm, &s, m, &a, &res, offsets, NULL);
+                soa_nodes += res.nodes;
+            }
+            double t_soa = now() - t0;
 
             size_t bnodes = 0;
             t0 = now();
@@ -122,14 +182,16 @@ int main(int argc, char **argv)
             double t_bwd = now() - t0;
             if (m == 0)
                 t_pol = t_fwd;
-            printf("%-10s %5d %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], depths[di],
-                   nodes / t_fwd, batch_nodes / t_batch, bnodes / t_bwd, t_fwd / t_pol);
+            printf("%-10s %5d %14.3e %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], a.max_depth,
+                   nodes / t_fwd, batch_nodes / t_batch, soa_nodes / t_soa, bnodes / t_bwd,
+                   t_pol > 0.0 ? t_fwd / t_pol : 1.0);
         }
     }
     lp_backward_destroy(bw);
     lp_result_release(&res);
     free(rays);
     free(offsets);
+    free(soa);
     lp_lens_destroy(lens);
     return 0;
 }

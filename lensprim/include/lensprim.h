@@ -490,6 +490,40 @@ LP_API lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in,
                                        lp_result *out, size_t *offsets,
                                        lp_error *err);
 
+/* Revision 2.  Many rays of ONE wavelength as a structure of arrays:
+ * element i of every array belongs to ray i.  The origin, direction and
+ * field-direction arrays and the intensities are required; op, phase,
+ * kphi and ch may each be NULL, which stands for 0 for every ray. */
+typedef struct lp_ray_soa {
+    const double *ox, *oy, *oz; /* origins, world, mm */
+    const double *dx, *dy, *dz; /* directions, world (normalized here) */
+    const double *vx, *vy, *vz; /* field directions vp, world (made
+                                   perpendicular to dir and normalized) */
+    const double *intensity;    /* finite, >= 0 */
+    const double *op;           /* optical paths so far, mm; NULL: 0 */
+    const double *phase;        /* extra phases, rad; NULL: 0 */
+    const int *kphi;            /* phase-jump counts; NULL: 0 */
+    const uint64_t *ch;         /* source ids; NULL: 0 */
+} lp_ray_soa;
+
+/* Revision 2.  Forward trace of the n rays of `in`, all at lambda_nm (in
+ * standard air).  The result is exactly lp_trace_forward_many's on the
+ * same rays given as lp_ray records with that wavelength: the same
+ * outgoing rays in the same order, the same offsets (n + 1 entries) and
+ * the same bookkeeping, bit for bit.  What depends on the wavelength
+ * alone (the indices, the absorption, the data-range check) is computed
+ * once per call, and the checks and frame changes of the rays run in a
+ * loop the compiler vectorizes across rays.  A wavelength that is not a
+ * finite number > 0 fails the call before any ray (also when n is 0).
+ * NULL lens, out or offsets, a NULL in when n > 0, or a required array
+ * that is NULL when n > 0 gives LP_ERROR_INVALID_ARGUMENT.  The first
+ * invalid ray stops the call with its index in the message, as
+ * lp_trace_forward_many; out then holds the rays traced before it. */
+LP_API lp_status lp_trace_forward_soa(const lp_lens *lens, double lambda_nm,
+                                      const lp_ray_soa *in, size_t n,
+                                      const lp_trace_args *args, lp_result *out,
+                                      size_t *offsets, lp_error *err);
+
 /* ------------------------------------------------------------------ */
 /* Backward tracing (from the eye), in two phases                      */
 /* ------------------------------------------------------------------ */

@@ -6,9 +6,9 @@
 
 #include "fresnel.h"
 
-double lp__refraction_cos(double cos_i, double n1, double n2)
+/* The cosine of refraction for the relative index eta = n1/n2, or -1. */
+static double refraction_cos(double cos_i, double eta)
 {
-    double eta = n1 / n2;
     /* sin^2 i written as (1-c)(1+c): no cancellation at grazing incidence */
     double sin2_i = (1.0 - cos_i) * (1.0 + cos_i);
     double cos2_t = 1.0 - eta * eta * sin2_i;
@@ -17,10 +17,16 @@ double lp__refraction_cos(double cos_i, double n1, double n2)
     return sqrt(cos2_t);
 }
 
+double lp__refraction_cos(double cos_i, double n1, double n2)
+{
+    return refraction_cos(cos_i, n1 / n2);
+}
+
 void lp__fresnel_eval(double cos_i, double n1, double n2, lp__fresnel *f)
 {
     double ci = cos_i < 0.0 ? 0.0 : (cos_i > 1.0 ? 1.0 : cos_i);
 
+    f->eta = n1 / n2;
     if (n1 == n2) { /* no interface at all */
         f->tir = 0;
         f->cos_t = ci;
@@ -30,7 +36,7 @@ void lp__fresnel_eval(double cos_i, double n1, double n2, lp__fresnel *f)
         return;
     }
 
-    double ct = lp__refraction_cos(ci, n1, n2);
+    double ct = refraction_cos(ci, f->eta);
     if (ct < 0.0) {
         /* Total internal reflection.  The transmitted wave is evanescent:
          * n2*cos_t = i*q with q = sqrt(n1^2 sin^2 i - n2^2) > 0, the sign
@@ -51,15 +57,16 @@ void lp__fresnel_eval(double cos_i, double n1, double n2, lp__fresnel *f)
 
     double a = n1 * ci, b = n2 * ct; /* s: n1 cos i, n2 cos t */
     double c = n2 * ci, d = n1 * ct; /* p: n2 cos i, n1 cos t */
-    double rs = (a - b) / (a + b);
-    double rp = (c - d) / (c + d);
+    double is = 1.0 / (a + b), ip = 1.0 / (c + d); /* shared by r and t */
+    double rs = (a - b) * is;
+    double rp = (c - d) * ip;
     double g = 2.0 * sqrt(a * b); /* 2 sqrt(n1 ci n2 ct) */
     f->tir = 0;
     f->cos_t = ct;
     f->rs = rs;
     f->rp = rp;
-    f->ts = g / (a + b);
-    f->tp = g / (c + d);
+    f->ts = g * is;
+    f->tp = g * ip;
     f->Rs = rs * rs;
     f->Rp = rp * rp;
 }

@@ -20,6 +20,7 @@
 
 typedef struct lp__fresnel {
     int tir;               /* 1 beyond the critical angle: no transmitted wave */
+    double eta;            /* n1 / n2 */
     double cos_t;          /* cosine of the refraction angle; 0 under TIR */
     double complex rs, rp; /* amplitude reflection coefficients */
     double ts, tp;         /* power-normalized transmission amplitudes, >= 0 */

@@ -9,30 +9,44 @@
 
 #include "interface.h"
 
+/* The s axis at normal incidence: the incoming field's own direction
+ * (its real part, or its imaginary part if that is all it has), else any
+ * axis perpendicular to d. */
+static lp_vec3 hint_axis(lp_vec3 d, const lp__cvec3 *hint)
+{
+    lp_vec3 e = hint ? cv3_re(*hint) : v3(0, 0, 0);
+    if (hint && v3_dot(e, e) == 0.0)
+        e = cv3_im(*hint);
+    e = v3_sub(e, v3_scale(d, v3_dot(e, d)));
+    return v3_dot(e, e) > 0.0 ? v3_normalize(e) : v3_any_perp(d);
+}
+
 int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
                    const lp__cvec3 *hint)
 {
     double dn = v3_dot(d, normal);
+    double adn = fabs(dn);
     node->d = d;
     node->n1 = n1;
     node->n2 = n2;
     node->n = dn > 0.0 ? v3_neg(normal) : normal;
-    node->cos_i = fmin(1.0, fabs(dn));
+    node->cos_i = adn < 1.0 ? adn : 1.0;
     lp__fresnel_eval(node->cos_i, n1, n2, &node->f);
 
     lp_vec3 s = v3_cross(d, node->n);
-    double sl = v3_len(s);
-    if (sl > 1e-9) {
-        node->s = v3_scale(s, 1.0 / sl);
-    } else {
-        /* Normal incidence: keep the incoming field's frame. */
-        lp_vec3 e = hint ? cv3_re(*hint) : v3(0, 0, 0);
-        if (hint && v3_dot(e, e) == 0.0)
-            e = cv3_im(*hint);
-        e = v3_sub(e, v3_scale(d, v3_dot(e, d)));
-        node->s = v3_dot(e, e) > 0.0 ? v3_normalize(e) : v3_any_perp(d);
-    }
+    double sl2 = v3_dot(s, s);
+    node->normal = !(sl2 > 1e-18);
+    node->s = node->normal ? hint_axis(d, hint) : v3_scale(s, 1.0 / sqrt(sl2));
+    node->p = v3_cross(d, node->s);
     return node->f.tir;
+}
+
+void lp__node_refit(lp__node *node, const lp__cvec3 *E)
+{
+    if (node->normal) {
+        node->s = hint_axis(node->d, E);
+        node->p = v3_cross(node->d, node->s);
+    }
 }
 
 static lp_vec3 reflect_dir(const lp__node *node)
@@ -49,11 +63,35 @@ double lp__node_reflectance(const lp__node *node, lp_mode mode)
     return 0.5 * (node->f.Rs + node->f.Rp);
 }
 
+/* E on the s and p axes of the incident wave; 1 when both are real. */
+static int project(const lp__node *node, const lp__cvec3 *E, double complex *es,
+                   double complex *ep)
+{
+    if (cv3_is_real(*E)) {
+        lp_vec3 e = cv3_re(*E);
+        *es = v3_dot(e, node->s);
+        *ep = v3_dot(e, node->p);
+        return 1;
+    }
+    *es = cv3_dot_real(*E, node->s);
+    *ep = cv3_dot_real(*E, node->p);
+    return 0;
+}
+
+/* a u + b w, in real arithmetic when a and b are real. */
+static lp__cvec3 combine(int real, double complex a, lp_vec3 u, double complex b, lp_vec3 w)
+{
+    if (real)
+        return cv3_real(v3_add(v3_scale(u, creal(a)), v3_scale(w, creal(b))), 1.0);
+    return cv3_combine(a, u, b, w);
+}
+
 void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp__branch *out)
 {
     lp_vec3 r = reflect_dir(node);
-    lp_vec3 pi = v3_cross(node->d, node->s), pr = v3_cross(r, node->s);
-    double complex es = cv3_dot_real(*E, node->s), ep = cv3_dot_real(*E, pi);
+    lp_vec3 pr = v3_cross(r, node->s);
+    double complex es, ep;
+    int real = project(node, E, &es, &ep);
 
     out->dir = r;
     out->flip = 0;
@@ -66,29 +104,34 @@ void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp
             rp = -rp;
             out->flip = 1;
         }
-        out->E = cv3_combine(rs * es, node->s, rp * ep, pr);
+        real = real && !node->f.tir;
+        if (real)
+            out->E = combine(1, creal(rs) * creal(es), node->s, creal(rp) * creal(ep), pr);
+        else
+            out->E = cv3_combine(rs * es, node->s, rp * ep, pr);
     } else {
         /* The mirror image of the field, scaled to the reflected power. */
         double k = sqrt(lp__node_reflectance(node, mode));
-        out->E = cv3_combine(k * es, node->s, -k * ep, pr);
+        out->E = combine(real, k * es, node->s, -k * ep, pr);
     }
 }
 
 void lp__node_transmit(const lp__node *node, lp_mode mode, const lp__cvec3 *E,
                        lp__branch *out)
 {
-    double eta = node->n1 / node->n2, ci = node->cos_i, ct = node->f.cos_t;
+    double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
     lp_vec3 t = v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
-    lp_vec3 pi = v3_cross(node->d, node->s), pt = v3_cross(t, node->s);
-    double complex es = cv3_dot_real(*E, node->s), ep = cv3_dot_real(*E, pi);
+    lp_vec3 pt = v3_cross(t, node->s);
+    double complex es, ep;
+    int real = project(node, E, &es, &ep);
 
     out->dir = t;
     out->flip = 0;
     if (mode == LP_MODE_POLARIZED) {
-        out->E = cv3_combine(node->f.ts * es, node->s, node->f.tp * ep, pt);
+        out->E = combine(real, node->f.ts * es, node->s, node->f.tp * ep, pt);
     } else {
         double T = 1.0 - lp__node_reflectance(node, mode);
         double k = sqrt(T > 0.0 ? T : 0.0);
-        out->E = cv3_combine(k * es, node->s, k * ep, pt);
+        out->E = combine(real, k * es, node->s, k * ep, pt);
     }
 }

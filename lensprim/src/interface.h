@@ -9,7 +9,12 @@
  * E * (-1)^kphi stays the physical field.  In the unpolarized modes the
  * field only carries a direction for v_p: its power is scaled by R or
  * 1 - R of the mode's law and its direction is mirrored or carried over
- * on the s/p axes. */
+ * on the s/p axes.
+ *
+ * Cost: a node is set up once (geometry, Fresnel factors, s/p axes) and
+ * serves both branches; a field whose components are all real (every
+ * field before a total internal reflection) is projected and rebuilt in
+ * real arithmetic. */
 #ifndef LP_INTERFACE_H
 #define LP_INTERFACE_H
 
@@ -30,7 +35,9 @@ typedef struct lp__node {
     double cos_i;
     lp__fresnel f;
     lp_vec3 s;        /* unit s axis */
+    lp_vec3 p;        /* unit p axis of the incident wave, d x s */
     double n1, n2;    /* indices before and after the boundary */
+    int normal;       /* normal incidence: s was taken from the hint */
 } lp__node;
 
 /* Set up a node: light along unit d meets a surface with unit normal
@@ -40,6 +47,11 @@ typedef struct lp__node {
  * own keeps the frame).  Returns 1 under total internal reflection. */
 int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
                    const lp__cvec3 *hint);
+
+/* A node set up once for any field (hint NULL) serves every field, except
+ * at normal incidence, where the s axis follows the field: this redoes
+ * the set-up for E then (node->normal), and is a no-op otherwise. */
+void lp__node_refit(lp__node *node, const lp__cvec3 *E);
 
 /* The reflected branch of G for field E in the given mode. */
 void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp__branch *out);

@@ -155,6 +155,12 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
     lens->v = v3_cross(lens->w, lens->u);
     if (desc->uniaxial)
         lens->crystal_axis = lp__to_local_dir(lens, lens->desc.crystal.axis);
+    {
+        double hz = 0.5 * (lens->z_max - lens->z_min);
+        double r = sqrt(lens->h_max * lens->h_max + hz * hz) * (1.0 + 1e-9) + 4.0 * lens->eps;
+        lens->bound_center = lp__to_world_point(lens, v3(0.0, 0.0, lens->z_min + hz));
+        lens->bound_r2 = r * r;
+    }
     *out = lens;
     lp__ok(err);
     return LP_OK;
@@ -178,27 +184,6 @@ double lp_lens_edge_thickness(const lp_lens *lens)
     return lens->rim.present ? lens->rim.z_b - lens->rim.z_a : 0.0;
 }
 
-lp_vec3 lp__to_local_point(const lp_lens *lens, lp_vec3 p)
-{
-    lp_vec3 q = v3_sub(p, lens->desc.position);
-    return v3(v3_dot(q, lens->u), v3_dot(q, lens->v), v3_dot(q, lens->w));
-}
-
-lp_vec3 lp__to_local_dir(const lp_lens *lens, lp_vec3 d)
-{
-    return v3(v3_dot(d, lens->u), v3_dot(d, lens->v), v3_dot(d, lens->w));
-}
-
-lp_vec3 lp__to_world_dir(const lp_lens *lens, lp_vec3 d)
-{
-    return v3_add(v3_add(v3_scale(lens->u, d.x), v3_scale(lens->v, d.y)), v3_scale(lens->w, d.z));
-}
-
-lp_vec3 lp__to_world_point(const lp_lens *lens, lp_vec3 p)
-{
-    return v3_add(lens->desc.position, lp__to_world_dir(lens, p));
-}
-
 void lp_lens_bounds(const lp_lens *lens, lp_vec3 *lo, lp_vec3 *hi)
 {
     lp_vec3 a = v3(INFINITY, INFINITY, INFINITY), b = v3(-INFINITY, -INFINITY, -INFINITY);
@@ -217,29 +202,44 @@ void lp_lens_bounds(const lp_lens *lens, lp_vec3 *lo, lp_vec3 *hi)
         *hi = b;
 }
 
+/* Is the local point p strictly inside the rim's solid cone (or
+ * cylinder) r < rho(z), by a relative margin far above rounding?  That
+ * solid is convex, so a segment between two such points cannot cross the
+ * rim, and its intersection test can be skipped. */
+static int inside_rim(const lp__rim *rim, lp_vec3 p)
+{
+    double rho = rim->rho_a + rim->k * (p.z - rim->z_a);
+    return rho > 0.0 && p.x * p.x + p.y * p.y < rho * rho * (1.0 - 1e-9);
+}
+
 int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
                  double t_min, double t_max, lp__local_hit *hit)
 {
     double best = t_max, t;
     int surface = LP_SURFACE_NONE;
+    /* A ray leaving a surface ignores hits on the others closer than eps. */
+    double t_other = from_surface == LP_SURFACE_NONE ? t_min : lp__max(t_min, lens->eps);
 
     for (int s = LP_SURFACE_FRONT; s <= LP_SURFACE_BACK; s++) {
         int self = s == from_surface;
-        double tmin = self ? t_min : fmax(t_min, from_surface == LP_SURFACE_NONE ? t_min : lens->eps);
-        if (lp__cap_intersect(&lens->cap[s], p, d, self, tmin, best, &t)) {
+        if (lp__cap_intersect(&lens->cap[s], p, d, self, self ? t_min : t_other, best, &t)) {
             best = t;
             surface = s;
         }
     }
-    double tmin_rim = from_surface == LP_SURFACE_NONE ? t_min : fmax(t_min, lens->eps);
-    if (lp__rim_intersect(&lens->rim, p, d, tmin_rim, best, &t)) {
+    lp_vec3 x = v3_madd(p, d, best);
+    int rim_possible = lens->rim.present &&
+                       !(from_surface != LP_SURFACE_NONE && surface != LP_SURFACE_NONE &&
+                         inside_rim(&lens->rim, p) && inside_rim(&lens->rim, x));
+    if (rim_possible && lp__rim_intersect(&lens->rim, p, d, t_other, best, &t)) {
         best = t;
         surface = LP_SURFACE_RIM;
+        x = v3_madd(p, d, best);
     }
     if (surface == LP_SURFACE_NONE)
         return 0;
     hit->t = best;
-    hit->p = v3_madd(p, d, best);
+    hit->p = x;
     hit->surface = surface;
     hit->n = surface == LP_SURFACE_RIM ? lp__rim_normal(&lens->rim, hit->p)
                                        : lp__cap_normal(&lens->cap[surface], hit->p);
@@ -276,6 +276,12 @@ int lp_lens_intersect(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir, double t
         return 0;
     lp_vec3 d = v3_normalize(dir);
     if (d.x == 0.0 && d.y == 0.0 && d.z == 0.0)
+        return 0;
+    /* A ray from outside the bounding sphere that misses it, or leaves
+     * it, cannot meet the lens. */
+    lp_vec3 oc = v3_sub(origin, lens->bound_center);
+    double b = v3_dot(oc, d), c = v3_dot(oc, oc) - lens->bound_r2;
+    if (c > 0.0 && (b > 0.0 || b * b < c))
         return 0;
     lp_vec3 p = lp__to_local_point(lens, origin);
     if (!lp__lens_hit(lens, p, lp__to_local_dir(lens, d), lp__lens_surface_at(lens, p), t_min,

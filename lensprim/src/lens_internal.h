@@ -10,6 +10,7 @@
 #define LP_LENS_INTERNAL_H
 
 #include "lensprim.h"
+#include "vec3.h"
 
 typedef struct lp__cap {
     double c;       /* curvature 1/R, 0 for flat */
@@ -36,6 +37,8 @@ struct lp_lens {
     double eps;       /* distance below which a hit on ANOTHER surface
                          than the one a ray leaves is ignored */
     lp_vec3 crystal_axis; /* a crystal's optic axis, local, unit */
+    lp_vec3 bound_center; /* world centre of a sphere holding the lens */
+    double bound_r2;      /* its squared radius, with a margin */
 };
 
 /* A hit in the local frame. */
@@ -74,10 +77,22 @@ int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
  * never meets its own origin again. */
 int lp__lens_surface_at(const lp_lens *lens, lp_vec3 p);
 
-/* World <-> local. */
-lp_vec3 lp__to_local_point(const lp_lens *lens, lp_vec3 p);
-lp_vec3 lp__to_local_dir(const lp_lens *lens, lp_vec3 d);
-lp_vec3 lp__to_world_point(const lp_lens *lens, lp_vec3 p);
-lp_vec3 lp__to_world_dir(const lp_lens *lens, lp_vec3 d);
+/* World <-> local (inline: every node and outgoing ray uses them). */
+static inline lp_vec3 lp__to_local_dir(const lp_lens *lens, lp_vec3 d)
+{
+    return v3(v3_dot(d, lens->u), v3_dot(d, lens->v), v3_dot(d, lens->w));
+}
+static inline lp_vec3 lp__to_local_point(const lp_lens *lens, lp_vec3 p)
+{
+    return lp__to_local_dir(lens, v3_sub(p, lens->desc.position));
+}
+static inline lp_vec3 lp__to_world_dir(const lp_lens *lens, lp_vec3 d)
+{
+    return v3_add(v3_add(v3_scale(lens->u, d.x), v3_scale(lens->v, d.y)), v3_scale(lens->w, d.z));
+}
+static inline lp_vec3 lp__to_world_point(const lp_lens *lens, lp_vec3 p)
+{
+    return v3_add(lens->desc.position, lp__to_world_dir(lens, p));
+}
 
 #endif

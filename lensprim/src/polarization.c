@@ -18,6 +18,12 @@ int lp__field_split(const lp__cvec3 *E, lp_vec3 dir, lp__linear_part part[2])
     double total = cv3_norm2(*E);
     if (!(total > 0.0))
         return 0;
+    if (cv3_is_real(*E)) { /* linear already: psi = 0, A = E, B = 0 */
+        part[0].intensity = total;
+        part[0].vp = unit_perp(cv3_re(*E), dir);
+        part[0].phase = 0.0;
+        return 1;
+    }
 
     double complex q = E->x * E->x + E->y * E->y + E->z * E->z;
     double psi = (cimag(q) == 0.0 && creal(q) >= 0.0) ? 0.0 : 0.5 * carg(q);

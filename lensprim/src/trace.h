@@ -37,12 +37,26 @@ typedef struct lp__payload {
     uint64_t ch;
 } lp__payload;
 
-/* Append the field E leaving the lens (local point p, local unit dir d)
- * to res as one or two linear rays.  Returns LP_ERROR_NO_MEMORY or LP_OK;
- * adds their power to res->out. */
-lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
-                   lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
-                   uint64_t path, lp_error *err);
+/* Where an outgoing ray leaves: its local unit direction d, and its world
+ * origin and direction. */
+typedef struct lp__exit {
+    lp_vec3 d;
+    lp_vec3 world_origin, world_dir;
+} lp__exit;
+
+/* The exit of a ray leaving the lens's local point p along the local unit
+ * direction d. */
+lp__exit lp__exit_at(const lp_lens *lens, lp_vec3 p, lp_vec3 d);
+
+/* Append the field E leaving the lens at x to res as one or two linear
+ * rays.  Returns LP_ERROR_NO_MEMORY or LP_OK; adds their power to
+ * res->out. */
+lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
+                   const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
+                   lp_error *err);
+
+/* x wrapped into [-pi, pi] (x itself when it lies there already). */
+double lp__wrap_phase(double x);
 
 /* Send one outgoing field (branch b, leaving the local point p) to the
  * result, or count its power as skipped when args' flags or filter
@@ -59,12 +73,46 @@ lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 lig
 
 /* Emit a gathered field E (of a bundle ray of power `in`, of which
  * `absorbed` went into the glass) as the rays of query q, leaving the
- * local point p along d; the rest of `in` is counted as truncated. */
-lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
-                            lp_vec3 d, const lp__payload *pl, const lp_query *q, double in,
-                            double absorbed, lp_error *err);
+ * lens at x; the rest of `in` is counted as truncated. */
+lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
+                            const lp__exit *x, const lp__payload *pl, const lp_query *q,
+                            double in, double absorbed, lp_error *err);
+
+/* The unit vector along the part of v perpendicular to the unit d; *ok
+ * is 0.0 when there is none (v parallel to d, zero or not finite), else
+ * 1.0.  Free of
+ * branches, for loops over many rays. */
+static inline lp_vec3 lp__perp_unit_core(lp_vec3 v, lp_vec3 d, double *ok)
+{
+    lp_vec3 w = v3_sub(v, v3_scale(d, v3_dot(v, d)));
+    double l = v3_len(w), lv = v3_len(v);
+    *ok = l > 1e-12 * lv ? lp__finite(l) : 0.0;
+    return v3_scale(w, 1.0 / l);
+}
 
 /* Make v a unit vector perpendicular to the unit d; 0 if impossible. */
-int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out);
+static inline int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
+{
+    double ok;
+    lp_vec3 u = lp__perp_unit_core(v, d, &ok);
+    if (ok == 0.0)
+        return 0;
+    *out = u;
+    return 1;
+}
+
+/* Check a forward input ray: its unit direction *d and the unit field
+ * direction *vp perpendicular to it (world). */
+lp_status lp__ray_check(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err);
+
+/* Prefix the message in err with "ray i: " and return st (batch calls). */
+lp_status lp__ray_failed(lp_error *err, lp_status st, size_t i);
+
+/* Trace a checked ray (lp__ray_check) at the optics o of its wavelength:
+ * local origin p, local unit direction d, local unit field direction vp;
+ * its intensity and payload from *in.  Adds to res (not cleared). */
+lp_status lp__trace_checked(const lp_lens *lens, const lp_ray *in, const lp__optics *o,
+                            lp_vec3 p, lp_vec3 d, lp_vec3 vp, const lp_trace_args *a,
+                            lp_result *res, lp_error *err);
 
 #endif

@@ -9,7 +9,10 @@
  * Refraction is reversible, so the light path is the eye path reversed;
  * at each node G is applied in the direction of light: at node k the
  * light refracts in (or, k = 1, reflects off the outside), at nodes
- * k-1..2 it reflects inside, at node 1 it refracts out. */
+ * k-1..2 it reflects inside, at node 1 it refracts out.  The nodes of the
+ * light's way are set up once per gather call, for any field: every
+ * bundle ray of the call runs through the same ones (only at normal
+ * incidence does a node's s axis follow the field: lp__node_refit). */
 #include <math.h>
 #include <stdlib.h>
 
@@ -23,6 +26,8 @@ typedef struct bw_node {
     lp_vec3 n;       /* outward normal */
     lp_vec3 e_out;   /* eye direction inside the glass leaving this node */
     double seg;      /* length from this node to the next one */
+    double seg_att;  /* amplitude factor over seg: exp(-alpha seg / 2) */
+    double seg_abs;  /* power fraction absorbed over seg: 1 - seg_att^2 */
     int surface;
 } bw_node;
 
@@ -36,6 +41,7 @@ struct lp_backward {
     size_t n_queries;
     lp_query query[LP_MAX_DEPTH];
     lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
+    lp__exit exit;                   /* where gathered light leaves */
     int rim_depth;
     unsigned warnings;
     lp__xback *xb;                 /* the last build's, through a crystal */
@@ -89,14 +95,29 @@ static double node_bound(const lp__node *nd, lp_mode mode, int reflect)
         return reflect ? R : 1.0 - R;
     }
     if (reflect)
-        return fmax(nd->f.Rs, nd->f.Rp);
-    return fmax(nd->f.ts * nd->f.ts, nd->f.tp * nd->f.tp);
+        return lp__max(nd->f.Rs, nd->f.Rp);
+    return lp__max(nd->f.ts * nd->f.ts, nd->f.tp * nd->f.tp);
 }
 
 static double node_weight(const lp__node *nd, lp_mode mode, int reflect)
 {
     double R = lp__node_reflectance(nd, mode == LP_MODE_POLARIZED ? LP_MODE_FRESNEL : mode);
     return reflect ? R : 1.0 - R;
+}
+
+/* The node where light answering query qi enters the lens (any field). */
+static void query_node(const lp_backward *bw, size_t qi, lp__node *nd)
+{
+    const lp_query *q = &bw->query[qi];
+    lp__node_setup(nd, v3_neg(bw->query_dir[qi]), bw->node[q->depth].n, bw->optics.n_medium,
+                   bw->optics.n_glass, NULL);
+}
+
+/* The node j of the way back, light arriving from inside (any field). */
+static void light_node(const lp_backward *bw, int j, lp__node *nd)
+{
+    lp__node_setup(nd, v3_neg(bw->node[j].e_out), bw->node[j].n, bw->optics.n_glass,
+                   bw->optics.n_medium, NULL);
 }
 
 static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
@@ -166,6 +187,7 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
         return lp__crystal_build(&bw->xb, lens, &bw->optics, &bw->args, d, &h, err);
 
     int entry = h.surface;
+    bw->exit = lp__exit_at(lens, h.p, v3_neg(d));
     bw->n_nodes = 1;
     bw->node[1].p = h.p;
     bw->node[1].n = h.n;
@@ -195,11 +217,14 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
             bw->warnings |= LP_WARN_LEAK;
             break;
         }
-        double att = o->alpha > 0.0 ? exp(-o->alpha * h.t) : 1.0;
+        double m = o->alpha > 0.0 ? expm1(-0.5 * o->alpha * h.t) : 0.0;
+        double att = (1.0 + m) * (1.0 + m);
         bound *= att;
         weight *= att;
         op += o->n_glass * h.t;
         bw->node[depth].seg = h.t;
+        bw->node[depth].seg_att = 1.0 + m;
+        bw->node[depth].seg_abs = -m * (2.0 + m);
         if (h.surface == LP_SURFACE_RIM) {
             bw->rim_depth = depth + 1;
             break;
@@ -229,20 +254,21 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     return LP_OK;
 }
 
-/* One bundle ray through the path of a query, in the direction of light. */
-static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, lp_result *res,
-                            lp_error *err)
+/* One bundle ray through the path of a query, in the direction of light;
+ * way[k] is the query's entry node, way[1..k-1] the light nodes. */
+static lp_status gather_one(const lp_backward *bw, size_t qi, const lp__node *way,
+                            const lp_ray *b, lp_result *res, lp_error *err)
 {
     const lp__optics *o = &bw->optics;
     const lp_query *q = &bw->query[qi];
     lp_mode mode = bw->args.mode;
     lp__node nd;
     lp__branch br;
-    lp_vec3 light = v3_neg(bw->query_dir[qi]); /* local, arriving at node k */
     lp_vec3 vp;
     int k = q->depth;
 
-    lp_status st0 = lp__bundle_ray_check(bw->lens, b, light, &vp, err);
+    nd = way[k];
+    lp_status st0 = lp__bundle_ray_check(bw->lens, b, nd.d, &vp, err);
     if (st0 != LP_OK)
         return st0;
 
@@ -252,35 +278,33 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp_ray *b, l
     double absorbed = 0.0;
     res->in += I0;
 
+    /* Node k: the light reflects off the outside (k = 1) or refracts in. */
+    lp__node_refit(&nd, &E);
     if (k == 1) {
-        lp__node_setup(&nd, light, bw->node[1].n, o->n_medium, o->n_glass, &E);
         lp__node_reflect(&nd, mode, &E, &br);
-        E = br.E;
         pl.kphi += br.flip;
     } else {
-        lp__node_setup(&nd, light, bw->node[k].n, o->n_medium, o->n_glass, &E);
         lp__node_transmit(&nd, mode, &E, &br);
-        E = br.E;
-        for (int j = k - 1; j >= 1; j--) {
-            double s = bw->node[j].seg;
-            if (o->alpha > 0.0) {
-                absorbed += cv3_norm2(E) * -expm1(-o->alpha * s);
-                E = cv3_scale(E, exp(-0.5 * o->alpha * s));
-            }
-            lp_vec3 dj = v3_neg(bw->node[j].e_out);
-            lp__node_setup(&nd, dj, bw->node[j].n, o->n_glass, o->n_medium, &E);
-            if (j > 1) {
-                lp__node_reflect(&nd, mode, &E, &br);
-                pl.kphi += br.flip;
-            } else {
-                lp__node_transmit(&nd, mode, &E, &br);
-            }
-            E = br.E;
+    }
+    E = br.E;
+    /* Nodes k-1..2 reflect it inside; node 1 refracts it out. */
+    for (int j = k - 1; j >= 1; j--) {
+        if (o->alpha > 0.0) {
+            absorbed += cv3_norm2(E) * bw->node[j].seg_abs;
+            E = cv3_scale_real(E, bw->node[j].seg_att);
         }
+        nd = way[j];
+        lp__node_refit(&nd, &E);
+        if (j > 1) {
+            lp__node_reflect(&nd, mode, &E, &br);
+            pl.kphi += br.flip;
+        } else {
+            lp__node_transmit(&nd, mode, &E, &br);
+        }
+        E = br.E;
     }
     res->nodes += (size_t)k;
-    return lp__emit_gathered(bw->lens, res, &E, bw->node[1].p, v3_neg(bw->view_dir), &pl, q,
-                             I0, absorbed, err);
+    return lp__emit_gathered(bw->lens, res, &E, &bw->exit, &pl, q, I0, absorbed, err);
 }
 
 lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
@@ -295,9 +319,16 @@ lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bund
         return lp__fail(err, LP_ERROR_RANGE, "query %zu does not exist (%zu queries)", q,
                         bw->n_queries);
     out->warnings |= bw->warnings;
-    for (size_t i = 0; i < n; i++)
-        if ((st = gather_one(bw, q, &bundle[i], out, err)) != LP_OK)
-            return st;
+    if (n > 0) {
+        lp__node way[LP_MAX_DEPTH + 1];
+        int k = bw->query[q].depth;
+        query_node(bw, q, &way[k]);
+        for (int j = 1; j < k; j++)
+            light_node(bw, j, &way[j]);
+        for (size_t i = 0; i < n; i++)
+            if ((st = gather_one(bw, q, way, &bundle[i], out, err)) != LP_OK)
+                return st;
+    }
     lp__ok(err);
     return LP_OK;
 }

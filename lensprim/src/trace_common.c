@@ -89,36 +89,36 @@ int lp__branch_keep(const lp_lens *lens, const lp_trace_args *a, int depth, lp_k
     return lp__args_keep(a, info);
 }
 
-int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
+lp__exit lp__exit_at(const lp_lens *lens, lp_vec3 p, lp_vec3 d)
 {
-    lp_vec3 w = v3_sub(v, v3_scale(d, v3_dot(v, d)));
-    double l = v3_len(w), lv = v3_len(v);
-    if (!(l > 1e-12 * lv) || !isfinite(l))
-        return 0;
-    *out = v3_scale(w, 1.0 / l);
-    return 1;
+    lp__exit x = {d, lp__to_world_point(lens, p), lp__to_world_dir(lens, d)};
+    return x;
 }
 
-lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
-                   lp_vec3 d, const lp__payload *pl, int depth, lp_kind kind, int surface,
-                   uint64_t path, lp_error *err)
+double lp__wrap_phase(double x)
+{
+    return fabs(x) <= LP_PI ? x : remainder(x, 2.0 * LP_PI);
+}
+
+lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
+                   const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
+                   lp_error *err)
 {
     lp__linear_part part[2];
-    int n = lp__field_split(E, d, part);
-    lp_vec3 wp = lp__to_world_point(lens, p), wd = lp__to_world_dir(lens, d);
+    int n = lp__field_split(E, x->d, part);
 
     for (int k = 0; k < n; k++) {
         lp_out_ray *o = lp__result_push(res);
         if (!o)
             return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
-        o->ray.origin = wp;
-        o->ray.dir = wd;
+        o->ray.origin = x->world_origin;
+        o->ray.dir = x->world_dir;
         o->ray.lambda_nm = pl->lambda_nm;
         o->ray.intensity = part[k].intensity;
         o->ray.vp = lp__to_world_dir(lens, part[k].vp);
         o->ray.kphi = pl->kphi;
         o->ray.op = pl->op;
-        o->ray.phase = remainder(pl->phase + part[k].phase, 2.0 * LP_PI);
+        o->ray.phase = lp__wrap_phase(pl->phase + part[k].phase);
         o->ray.ch = pl->ch;
         o->depth = depth;
         o->kind = kind;
@@ -137,13 +137,20 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
                     lp_kind kind, int surface, uint64_t path, lp_error *err)
 {
     lp_branch_info info;
+    lp__exit x = lp__exit_at(lens, p, b->dir);
     double power = cv3_norm2(b->E);
 
-    if (!lp__branch_keep(lens, a, depth, kind, surface, p, b->dir, power, &info)) {
+    info.depth = depth;
+    info.kind = kind;
+    info.surface = surface;
+    info.origin = x.world_origin;
+    info.dir = x.world_dir;
+    info.bound = power;
+    if (!lp__args_keep(a, &info)) {
         res->skipped += power;
         return LP_OK;
     }
-    return lp__emit(lens, res, &b->E, p, b->dir, pl, depth, kind, surface, path, err);
+    return lp__emit(lens, res, &b->E, &x, pl, depth, kind, surface, path, err);
 }
 
 lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,
@@ -159,13 +166,13 @@ lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 lig
     return LP_OK;
 }
 
-lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, lp_vec3 p,
-                            lp_vec3 d, const lp__payload *pl, const lp_query *q, double in,
-                            double absorbed, lp_error *err)
+lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
+                            const lp__exit *x, const lp__payload *pl, const lp_query *q,
+                            double in, double absorbed, lp_error *err)
 {
     double before = res->out;
     size_t first = res->count;
-    lp_status st = lp__emit(lens, res, E, p, d, pl, q->depth, q->kind, q->surface, q->path, err);
+    lp_status st = lp__emit(lens, res, E, x, pl, q->depth, q->kind, q->surface, q->path, err);
     if (st != LP_OK)
         return st;
     for (size_t i = first; i < res->count; i++)

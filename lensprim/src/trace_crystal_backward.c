@@ -342,8 +342,8 @@ static lp_status gather_one(const lp__xback *x, size_t qi, const lp_ray *b, lp_r
         res->absorbed_glass += absorbed;
         return LP_OK;
     }
-    return lp__emit_gathered(x->lens, res, &E, x->node[0].p, v3_neg(x->view_dir), &pl, q, I0,
-                             absorbed, err);
+    lp__exit ex = lp__exit_at(x->lens, x->node[0].p, v3_neg(x->view_dir));
+    return lp__emit_gathered(x->lens, res, &E, &ex, &pl, q, I0, absorbed, err);
 }
 
 lp_status lp__crystal_gather(const lp__xback *x, size_t q, const lp_ray *bundle, size_t n,

@@ -13,7 +13,7 @@
 #include "trace.h"
 #include "trace_crystal.h"
 
-static lp_status check_ray(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err)
+lp_status lp__ray_check(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err)
 {
     if (!v3_finite(in->origin))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "ray origin is not finite");
@@ -33,23 +33,41 @@ static lp_status check_ray(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *
     return LP_OK;
 }
 
+lp_status lp__ray_failed(lp_error *err, lp_status st, size_t i)
+{
+    if (err) {
+        lp_error e = *err;
+        lp__fail(err, st, "ray %zu: %s", i, e.message);
+    }
+    return st;
+}
+
 static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace_args *a,
                            lp_result *res, lp_error *err)
 {
-    lp_vec3 dw, vpw;
+    lp_vec3 dw = {0, 0, 0}, vpw = dw;
     lp__optics o;
+    lp_status st;
+
+    if ((st = lp__ray_check(in, &dw, &vpw, err)) != LP_OK)
+        return st;
+    if ((st = lp__optics_at(lens, in->lambda_nm, &o, err)) != LP_OK)
+        return st;
+    return lp__trace_checked(lens, in, &o, lp__to_local_point(lens, in->origin),
+                             lp__to_local_dir(lens, dw), lp__to_local_dir(lens, vpw), a, res,
+                             err);
+}
+
+lp_status lp__trace_checked(const lp_lens *lens, const lp_ray *in, const lp__optics *op,
+                            lp_vec3 p, lp_vec3 d, lp_vec3 vp, const lp_trace_args *a,
+                            lp_result *res, lp_error *err)
+{
+    lp__optics o = *op;
     lp__local_hit h;
     lp__node node;
     lp__branch refl, trans;
     lp_status st;
 
-    if ((st = check_ray(in, &dw, &vpw, err)) != LP_OK)
-        return st;
-    if ((st = lp__optics_at(lens, in->lambda_nm, &o, err)) != LP_OK)
-        return st;
-
-    lp_vec3 p = lp__to_local_point(lens, in->origin);
-    lp_vec3 d = lp__to_local_dir(lens, dw);
     if (!lp__lens_hit(lens, p, d, lp__lens_surface_at(lens, p), 0.0, INFINITY, &h))
         return LP_OK; /* missed: the lens received nothing */
 
@@ -62,7 +80,7 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
     }
 
     lp__payload pl = {in->lambda_nm, in->kphi, in->op, in->phase, in->ch};
-    lp__cvec3 E = cv3_real(lp__to_local_dir(lens, vpw), sqrt(I0));
+    lp__cvec3 E = cv3_real(vp, sqrt(I0));
     if (lens->desc.uniaxial)
         return lp__crystal_forward(lens, &o, a, &h, d, &E, &pl, res, err);
     int entry = h.surface, depth = 1;
@@ -100,8 +118,11 @@ static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace
         }
         /* Along the segment: Beer-Lambert and the optical path. */
         if (o.alpha > 0.0) {
-            res->absorbed_glass += power * -expm1(-o.alpha * h.t);
-            E = cv3_scale(E, exp(-0.5 * o.alpha * h.t));
+            /* amplitude 1 + m, m = expm1(-alpha t / 2); absorbed power
+             * 1 - (1 + m)^2 = -m (2 + m), free of cancellation */
+            double m = expm1(-0.5 * o.alpha * h.t);
+            res->absorbed_glass += power * (-m * (2.0 + m));
+            E = cv3_scale_real(E, 1.0 + m);
         }
         pl.op += o.n_glass * h.t;
         p = h.p;
@@ -161,13 +182,8 @@ lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in, size_t n,
         return st;
     for (size_t i = 0; i < n; i++) {
         offsets[i] = out->count;
-        if ((st = trace_one(lens, &in[i], &a, out, err)) != LP_OK) {
-            if (err) {
-                lp_error e = *err;
-                lp__fail(err, st, "ray %zu: %s", i, e.message);
-            }
-            return st;
-        }
+        if ((st = trace_one(lens, &in[i], &a, out, err)) != LP_OK)
+            return lp__ray_failed(err, st, i);
     }
     offsets[n] = out->count;
     lp__ok(err);

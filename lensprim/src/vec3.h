@@ -4,6 +4,7 @@
 #ifndef LP_VEC3_H
 #define LP_VEC3_H
 
+#include <float.h>
 #include <math.h>
 #include "lensprim.h"
 
@@ -26,16 +27,30 @@ static inline lp_vec3 v3_madd(lp_vec3 a, lp_vec3 b, double s)
     return v3(a.x + s * b.x, a.y + s * b.y, a.z + s * b.z);
 }
 static inline int v3_finite(lp_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
-/* Unit vector along a; a zero or non-finite a gives (0,0,0). */
+/* fmax(a, b) exactly (a NaN gives the other argument), inline and free of
+ * branches, so that loops over many rays can be vectorized. */
+static inline double lp__fmax(double a, double b)
+{
+    double m = a > b ? a : b;
+    return b != b ? a : m;
+}
+/* The larger of two numbers that are not NaN (inline,
+ * unlike fmax, which must handle NaN). */
+static inline double lp__max(double a, double b) { return a > b ? a : b; }
+/* 1.0 when a is finite (as isfinite), else 0.0, without branches. */
+static inline double lp__finite(double a) { return fabs(a) <= DBL_MAX ? 1.0 : 0.0; }
+/* Unit vector along a; a zero or non-finite a gives (0,0,0).  Free of
+ * branches (the quotients of a rejected vector are computed, then
+ * dropped), so that loops over many rays can be vectorized. */
 static inline lp_vec3 v3_normalize(lp_vec3 a)
 {
     /* Scale by the largest component first: exact for tiny (denormal) and
      * huge vectors, whose squared length would underflow or overflow. */
-    double m = fmax(fabs(a.x), fmax(fabs(a.y), fabs(a.z)));
-    if (!(m > 0.0) || !isfinite(m))
-        return v3(0.0, 0.0, 0.0);
+    double m = lp__fmax(fabs(a.x), lp__fmax(fabs(a.y), fabs(a.z)));
+    double ok = m > 0.0 ? lp__finite(m) : 0.0;
     a = v3(a.x / m, a.y / m, a.z / m); /* not * (1/m): 1/m can overflow */
-    return v3_scale(a, 1.0 / v3_len(a));
+    a = v3_scale(a, 1.0 / v3_len(a));
+    return v3(ok != 0.0 ? a.x : 0.0, ok != 0.0 ? a.y : 0.0, ok != 0.0 ? a.z : 0.0);
 }
 /* Any unit vector perpendicular to the unit vector a (deterministic). */
 static inline lp_vec3 v3_any_perp(lp_vec3 a)
