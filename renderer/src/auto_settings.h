@@ -4,37 +4,50 @@
  * E is the RMSE of linear RGB allowed against the scene's converged
  * reference (polarized, wavelengths and depth enough that doubling either
  * changes nothing, no branch cut-off).  The choice -- light model,
- * wavelength count, depth and cut-off -- splits E into budgets and keeps
- * each error source inside its own:
+ * wavelength count, depth and cut-off -- reads the scene first and
+ * measures on a small probe only what the scene alone cannot tell; E is
+ * split into budgets, each error source kept inside its own:
  *
- *   model       polarized when the scene needs it (a polarizer, a
- *               polarized light, a coherent light or global coherence: an
- *               unpolarized model is wrong there by the whole effect);
- *               otherwise fresnel when its measured departure from the
- *               polarized model on the probe pixels is within 30 % of E.
- *   wavelengths the midpoint rule's error falls as N^-p (p between 0.5
- *               and 1) where dispersion puts steps into the integrand over
- *               wavelength, and is 0 without dispersion and pigment
- *               colours; the probe pixels are rendered at 4, 8, 16, 32
- *               and 64 wavelengths: the errors of 4..32 are measured (the
- *               changes up to 64 plus the extrapolated rest), p comes
- *               from the changes 16->32->64, and beyond 64 the error is
- *               extrapolated as N^-p.  N is the least that keeps it
- *               within what the other budgets leave of E (at most 1024).
- *   cut-off     an error budget, not a fixed weight: a branch is dropped
- *               when the radiance it can still carry -- its bound on the
- *               path's power transmittance (the library's per-branch
- *               bound) times the brightest radiance anything in the scene
- *               sends -- is below 10 % of E; where light is coherent a
- *               branch of weight w changes a pixel by up to 2 sqrt(w)
- *               through interference, and the weight budget is squared.
- *   depth       deep enough that what the depth limit drops is the cut-off
- *               budget's business: 16 levels for E >= 1e-3, 32 below.
+ *   model       polarized when the scene needs it, read from the scene:
+ *               a polarizer, a crystal lens (its o and e rays part the
+ *               light by polarization), a polarized light, a coherent
+ *               light or global coherence -- an unpolarized model is
+ *               wrong there by the whole effect.  Otherwise fresnel when
+ *               its departure from polarized, measured on the probe, is
+ *               within half of E.
+ *   cut-off     an error budget, not a fixed weight.  Its floor comes from
+ *               the library's per-branch bounds: below it no dropped branch
+ *               can carry more than 10 % of E (bound on the path's power
+ *               transmittance x the brightest radiance in the scene; where
+ *               light is coherent a branch of weight w changes a pixel by
+ *               up to 2 sqrt(w) through interference, so the weight budget
+ *               is squared).  Most dropped branches carry far less than
+ *               their bound (they see a dark background), so cut-offs from
+ *               0.01 down by tens are measured on the probe and the first
+ *               whose change to the next, doubled, is within 20 % of E
+ *               stands; the floor ends the ladder.  Coherent scenes take
+ *               the floor: interference makes a faint branch matter.
+ *   wavelengths a ladder 4, 8, 16 ... on the probe, in the chosen model and
+ *               cut-off: the first N whose change to 2N, doubled, fits in
+ *               what the model and cut-off leave of E (at most 1024).
+ *               Without dispersion the first rung stands; through
+ *               dispersive glass the integrand over wavelength has a step
+ *               at every edge a pixel's spectrum crosses and the error
+ *               falls only as N^-0.5..N^-1.  Only the ladder's rungs are
+ *               chosen: counts between them are not measured, and the
+ *               error is not monotone in N.
+ *   depth       16 levels, or the scene's max_trace_level when larger:
+ *               the cut-off, not the depth, ends lens trees; the depth
+ *               limit matters only where light is not attenuated (TIR
+ *               traps, mirror pairs).
  *
- * The probe pixels are about one in 64 of the
- * image (at least 48 through glass and 16 elsewhere, each group weighted
- * by its share of the image): 124 wavelength samples (plus 32 for
- * fresnel) per probe pixel, a fraction of the render.  Nothing here renders the reference.
+ * The probe: one in 4 of the pixels whose camera ray meets a lens
+ * (through polarizers, which are thin sheets) and one in 32 of the others
+ * (at least 24 and 8, at most 1024 of each, lens pixels at most one in
+ * 16 of the image), each group weighted by its
+ * share of the image.  Its cost, wavelength samples summed over its
+ * renders, is returned; at 32 x 24 it is measured 0.2-0.45 of the chosen
+ * render's, less at larger sizes.  Nothing here renders the reference.
  *
  * No printing, no global state.  The caller's --depth, --wavelengths and
  * --cutoff, when given, are kept and the rest chosen around them. */
@@ -57,10 +70,14 @@ typedef struct rs_auto_request {
 } rs_auto_request;
 
 /* Choose.  out gets mode, wavelengths, depth, cutoff, width and height;
+ * *probe_samples (when not NULL) the probe's cost: its pixels times
+ * their wavelengths, summed over its renders (a render of the image
+ * costs width x height x wavelengths of them);
  * why gets one line (no newline) saying what was chosen and why.  The
  * scene must be prepared.  Returns 0, or -1 with a message (out of
  * memory, a camera that cannot be set up). */
 int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_opts *out,
-                   char *why, size_t why_size, char *msg, size_t msg_size);
+                   double *probe_samples, char *why, size_t why_size, char *msg,
+                   size_t msg_size);
 
 #endif

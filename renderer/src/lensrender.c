@@ -397,7 +397,8 @@ lr_status lr_renderer_create(lr_scene *scene, const lr_render_opts *opts, lr_ren
         rs_auto_request req = {opts->tolerance > 0.0 ? opts->tolerance : LR_TOLERANCE_DEFAULT,
                                opts->width, opts->height, opts->depth, opts->wavelengths,
                                opts->cutoff};
-        if (rs_auto_choose(&scene->s, &req, &ro, r->why, sizeof r->why, msg, sizeof msg) != 0) {
+        if (rs_auto_choose(&scene->s, &req, &ro, NULL, r->why, sizeof r->why, msg,
+                           sizeof msg) != 0) {
             free(r);
             return fail(err, LR_ERROR_RENDER, "%s: %s", scene->name, msg);
         }

@@ -239,7 +239,7 @@ static int write_png(const sa_points *ps, const char **names, size_t ns, const c
         pl_text(&img, x + 260, y + 30, 2, TOL_COLOR[1], "<> auto, E = 1e-3");
         pl_text(&img, x + 520, y + 30, 2, TOL_COLOR[2], "<> auto, E = 1e-4");
         pl_text(&img, x + 820, y + 30, 2, 0x606060u, "dotted: the three E");
-        pl_text(&img, x + 820, y, 2, UNCERTAIN_COLOR, "dashed: the reference's U");
+        pl_text(&img, x + 1100, y, 2, UNCERTAIN_COLOR, "dashed: the reference's U");
         snprintf(path, sizeof path, "%s/speed-accuracy.png", dir);
         rc = rs_png_write(path, &img, msg, msg_size);
     }
@@ -309,7 +309,10 @@ static const char *const PAGE_TEXT =
 "while that changes some pixel by more than 1e-5; then the wavelength\n"
 "count is doubled from 128 while the doubling changes some pixel by more\n"
 "than 1e-5, up to 16384 or until the next doubling is predicted to take\n"
-"more CPU time than the budget (`--reference-seconds`).  A cut-off, not\n"
+"more CPU time than the budget (`--reference-seconds`); where not even one\n"
+"doubling fits (the note says so), the doubling is measured at depth 16 and\n"
+"cut-off 1e-6 instead: the quadrature's error is the main paths', whose\n"
+"topology the deep, faint branches do not change.  A cut-off, not\n"
 "none: a branch below 1e-10 of the light changes a pixel by at most 1e-10\n"
 "of the brightest radiance (2e-5 through interference), while without one\n"
 "a birefringent plate's tree doubles at every bounce.  The midpoint rule's\n"
@@ -329,9 +332,12 @@ static const char *const PAGE_TEXT =
 "slower than 1 s once), and takes the median CPU time (user + system of\n"
 "the child process, from `wait4`): the machine is shared, and CPU time\n"
 "does not count the time other work held the cores, wall time would.\n"
-"A swept setting whose time, predicted from the reference's time per\n"
-"wavelength, exceeds `--point-seconds` is not run (the expensive scenes'\n"
-"highest wavelength counts).  The sweep: polarized and fresnel at 4-32\n"
+"A swept setting whose time, predicted from the time per wavelength of a\n"
+"polarized render at depth 16 and cut-off 1e-6, exceeds `--point-seconds`\n"
+"is not run (the expensive scenes' highest wavelength counts; the\n"
+"committed run: 5 s), and one that runs out of 4 × that much CPU time is\n"
+"left out (a scene's own cut-off of 0 at depth 16 on a birefringent\n"
+"plate: michel_levy, conoscope).  The sweep: polarized and fresnel at 4-32\n"
 "wavelengths × depth 4, 8, 16 × cut-off 1e-6, 1e-3, the scene's; at 64-512\n"
 "wavelengths depth 16 with 1e-6 and depth 8 with 1e-3; schlick at depth 16\n"
 "with 1e-6; rgb at every depth and cut-off.  It writes `speed-accuracy.csv`\n"

@@ -16,8 +16,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-int sa_run(char *const argv[], const char *dir, sa_run_result *out, char *msg,
-           size_t msg_size)
+int sa_run(char *const argv[], const char *dir, double cpu_limit, sa_run_result *out,
+           char *msg, size_t msg_size)
 {
     FILE *err = tmpfile();
     struct rusage ru;
@@ -40,6 +40,13 @@ int sa_run(char *const argv[], const char *dir, sa_run_result *out, char *msg,
     }
     if (pid == 0) {
         int null_fd = open("/dev/null", O_RDWR);
+        if (cpu_limit > 0.0) {
+            struct rlimit rl;
+            rl.rlim_cur = (rlim_t)cpu_limit + 1;
+            rl.rlim_max = rl.rlim_cur + 1;
+            if (setrlimit(RLIMIT_CPU, &rl) != 0)
+                _exit(126);
+        }
         if (null_fd < 0 || dup2(null_fd, 0) < 0 || dup2(null_fd, 1) < 0 ||
             dup2(fileno(err), 2) < 0 || (dir && chdir(dir) != 0))
             _exit(126);

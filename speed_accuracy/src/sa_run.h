@@ -19,9 +19,10 @@ typedef struct sa_run_result {
 } sa_run_result;
 
 /* Run argv[0] with argv (NULL-terminated) in directory dir (NULL: the
- * current one).  Returns 0 when the program ran (whatever its status), -1
+ * current one), with at most cpu_limit CPU seconds (RLIMIT_CPU, rounded
+ * up: past it the kernel ends the program with SIGXCPU; <= 0: no limit).  Returns 0 when the program ran (whatever its status), -1
  * with a message when it could not be started. */
-int sa_run(char *const argv[], const char *dir, sa_run_result *out, char *msg,
-           size_t msg_size);
+int sa_run(char *const argv[], const char *dir, double cpu_limit, sa_run_result *out,
+           char *msg, size_t msg_size);
 
 #endif
