@@ -506,7 +506,9 @@ static lp_ray *bundle_push(bundle *b, int lane)
 }
 
 /* A new shared ray at the end of b, no lane having it yet; its vector in
- * *I and *has (nl entries each).  NULL when out of memory. */
+ * *I and *has (nl entries each, all 0: a shared vector's intensity is 0
+ * in every lane that does not have the ray, so that a lane's sum may add
+ * the whole vector).  NULL when out of memory. */
 static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char **has)
 {
     if (b->ns == b->scap) {
@@ -529,6 +531,7 @@ static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char *
     *I = b->I + s * (size_t)nl;
     *has = b->has + s * (size_t)nl;
     memset(*has, 0, (size_t)nl);
+    memset(*I, 0, (size_t)nl * sizeof **I);
     return r;
 }
 
@@ -1469,22 +1472,27 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
             } else {
                 double *Io;
                 unsigned char *has;
-                int first = -1;
+                int first;
                 lp_ray ray = *gr;
                 size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
                 if (!(r = bundle_push_shared(out, nl, &Io, &has)))
                     return -1;
+                const unsigned char *ch = c->has + s;
+                const double *cI = c->I + s;
+                double gI = gr->intensity;
+                /* every lane in one pass (no branch: it vectorizes); a
+                 * lane without the ray, or failed, gets 0 */
                 for (int k = 0; k < nl; k++) {
-                    if (!c->has[s + (size_t)k] || fr->bad[k])
-                        continue;
-                    double I = c->I[s + (size_t)k];
+                    double I = cI[k];
                     double scale = I == I0 ? 1.0 : I / I0;
-                    has[k] = 1;
-                    Io[k] = scale != 1.0 ? gr->intensity * scale : gr->intensity;
-                    if (first < 0)
-                        first = k;
+                    double v = scale != 1.0 ? gI * scale : gI;
+                    unsigned char keep = ch[k] & (unsigned char)(fr->bad[k] ^ 1);
+                    has[k] = keep;
+                    Io[k] = keep ? v : 0.0;
                 }
-                if (first < 0) { /* every lane failed: no ray */
+                for (first = 0; first < nl && !has[first]; first++)
+                    ;
+                if (first == nl) { /* every lane failed: no ray */
                     out->n--;
                     out->ns--;
                     break;
@@ -1633,8 +1641,16 @@ static void pol_values(rs_worker *w, lp_vec3 o, lp_vec3 d, double *L)
          * order, as rs_coherent_power forms it */
         for (int k = 0; k < nl; k++)
             L[k] = 0.0;
-        for (size_t i = 0; i < p->n; i++)
-            FOR_LANES(p, i, nl, k, I, L[k] += I);
+        for (size_t i = 0; i < p->n; i++) {
+            int l = p->lane[i];
+            if (l >= 0) {
+                L[l] += p->r[i].intensity;
+            } else { /* a lane without the ray adds 0 (bundle_push_shared) */
+                const double *I = p->I + (size_t)(-1 - l) * (size_t)nl;
+                for (int k = 0; k < nl; k++)
+                    L[k] += I[k];
+            }
+        }
         for (int k = 0; k < nl; k++)
             L[k] = L[k] > 0.0 ? L[k] : 0.0;
         return;
