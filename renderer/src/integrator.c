@@ -124,8 +124,19 @@ typedef struct colour_entry {
 
 
 
+/* A query ray's hit in the scene, kept for the next sub-packet (query_hit). */
+#define RS_QUERY_MEMO 8
+typedef struct query_memo {
+    lp_vec3 origin, dir;
+    int found;
+    rs_hit h;
+} query_memo;
+
 typedef struct frame {
     lp_backward *bw;
+    query_memo qm[RS_QUERY_MEMO];
+    unsigned qm_valid; /* bit j: qm[j] holds a ray */
+    rs_hit qh_spare;
     bundle child;
     lp_result res;
     /* Shared gathers (gather_shared): per ray of child its group; per
@@ -604,11 +615,6 @@ static double band_light_eval(const rs_integrator *it, const band *b, int k)
     return rs_spectrum_emission_norm(&s, it->light_norm[k], b->lambda);
 }
 
-/* The power of light k in band b (one of it->lanes), from the table. */
-static double band_light(const rs_integrator *it, const band *b, int k)
-{
-    return it->lane_light[(size_t)k * (size_t)it->n_lanes + (size_t)(b - it->lanes)];
-}
 
 /* The tables of light and background per lane (see struct rs_integrator). */
 static int make_lane_tables(rs_integrator *it)
@@ -904,15 +910,42 @@ static void shade_begin(rs_worker *w, const int *lane, int n, const rs_hit *h, l
  * (N.L)^brilliance plus the highlights.  Calls emit(source, radiance) for
  * each non-zero source.  The lanes of a packet share sp, and with it
  * their shadow rays. */
+/* What light k adds at sp in lane `lane` to a surface of diffuse
+ * reflectance rho there: 1 and the radiance in *v, or 0 where it adds
+ * nothing (behind the surface, dark in the lane, or in shadow). */
+static int light_term(const rs_integrator *it, shade_point *sp, double rho, size_t lane, size_t k,
+                      double *v)
+{
+    double s = sp->s[k];
+    double diff = sp->cb[k] >= 0.0 ? rho * sp->cb[k] : 0.0;
+    if (diff + s <= 0.0)
+        return 0;
+    double p = it->lane_light[k * (size_t)it->n_lanes + lane];
+    if (p == 0.0)
+        return 0;
+    if (isnan(sp->reach[k]))
+        sp->reach[k] = light_reach(it, sp->x, (int)k);
+    p *= sp->reach[k];
+    if (p == 0.0)
+        return 0;
+    *v = (diff + s) * p;
+    return 1;
+}
+
+/* Whether a surface of diffuse reflectance rho reflects any light. */
+static int lit(const rs_finish *f, double rho)
+{
+    return !(rho == 0.0 && f->phong == 0.0 && f->specular == 0.0);
+}
+
 static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_fn emit,
                   void *ctx)
 {
     const rs_scene *sc = it->scene;
     const rs_hit *h = sp->h;
-    const rs_object *o = h->surface;
-    const rs_finish *f = &o->finish;
+    const rs_finish *f = &h->surface->finish;
     size_t lane = (size_t)(b - it->lanes);
-    double e = sp->emission[lane];
+    double e = sp->emission[lane], v;
     if (e != 0.0)
         emit(ctx, src_object(it, h->object), e);
     double a = sp->ambient[lane];
@@ -921,23 +954,11 @@ static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_
     if (sc->n_lights == 0)
         return;
     double rho = sp->pigment[lane] * f->diffuse;
-    if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
+    if (!lit(f, rho))
         return;
-    for (size_t k = 0; k < sc->n_lights; k++) {
-        double s = sp->s[k];
-        double diff = sp->cb[k] >= 0.0 ? rho * sp->cb[k] : 0.0;
-        if (diff + s <= 0.0)
-            continue;
-        double p = band_light(it, b, (int)k);
-        if (p == 0.0)
-            continue;
-        if (isnan(sp->reach[k]))
-            sp->reach[k] = light_reach(it, sp->x, (int)k);
-        p *= sp->reach[k];
-        if (p == 0.0)
-            continue;
-        emit(ctx, src_light(it, (int)k), (diff + s) * p);
-    }
+    for (size_t k = 0; k < sc->n_lights; k++)
+        if (light_term(it, sp, rho, lane, k, &v))
+            emit(ctx, src_light(it, (int)k), v);
 }
 
 /* The mirror reflectivity of a surface in each lane lane[k] of a packet
@@ -1030,18 +1051,52 @@ static int lens_next(const rs_integrator *it, frame *fr, const rs_object *ob, in
  * along the ray, into out[0..n).  The lanes travel as one spectral packet
  * (packet.h) and split at a lens where their optics differ; each lane's
  * sums are formed in the same order as if it were traced alone. */
+static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
+                             const rs_hit *hit, int level, double weight, int f, double *out);
+
 static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
                          double weight, int skip, int f, double *out)
 {
+    rs_hit h;
+    int found = rs_scene_intersect(w->it->scene, o, d, 0.0, INFINITY, skip, &h);
+    trace_scalar_hit(w, lane, n, o, d, found ? &h : NULL, level, weight, f, out);
+}
+
+/* Where query j of a lens hit's sub-packet meets the scene (NULL:
+ * nowhere), kept per query index for the next sub-packet: the
+ * sub-packets of a dispersive lens share the queries that do not depend
+ * on the wavelength (the reflection off the outside), and the same ray
+ * meets the scene at the same point. */
+static const rs_hit *query_hit(const rs_scene *sc, frame *fr, size_t j, const lp_query *q)
+{
+    if (j >= RS_QUERY_MEMO) {
+        int found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &fr->qh_spare);
+        return found ? &fr->qh_spare : NULL;
+    }
+    query_memo *m = &fr->qm[j];
+    if (!(fr->qm_valid >> j & 1u) || memcmp(&m->origin, &q->origin, sizeof m->origin) != 0 ||
+        memcmp(&m->dir, &q->dir, sizeof m->dir) != 0) {
+        m->origin = q->origin;
+        m->dir = q->dir;
+        m->found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h);
+        fr->qm_valid |= 1u << j;
+    }
+    return m->found ? &m->h : NULL;
+}
+
+/* trace_scalar once the ray's hit is known (NULL: it meets nothing). */
+static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
+                             const rs_hit *hit, int level, double weight, int f, double *out)
+{
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
-    rs_hit h;
 
-    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
+    if (!hit) {
         for (int k = 0; k < n; k++)
             out[k] = it->lane_background[lane[k]];
         return;
     }
+    const rs_hit h = *hit;
     for (int k = 0; k < n; k++)
         out[k] = 0.0;
     const rs_object *ob = h.surface;
@@ -1052,14 +1107,15 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
         if (!fr || !lens_args(it, level, weight, &a))
             return;
         memset(fr->done, 0, (size_t)n);
+        fr->qm_valid = 0;
         while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             for (int k = 0; k < m; k++)
                 fr->acc[k] = 0.0;
             for (size_t j = 0; j < nq; j++) {
-                trace_scalar(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
-                             weight * q[j].weight, -1, f + 1, fr->val);
+                trace_scalar_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, j, &q[j]),
+                                 level + q[j].depth, weight * q[j].weight, f + 1, fr->val);
                 for (int k = 0; k < m; k++)
                     fr->acc[k] += q[j].weight * fr->val[k];
             }
@@ -1201,24 +1257,12 @@ static void shade_packet(const rs_integrator *it, const int *lane, int n, shade_
         return;
     for (int k = 0; k < n; k++) {
         size_t l = (size_t)lane[k];
-        double rho = sp->pigment[l] * f->diffuse;
-        if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
+        double rho = sp->pigment[l] * f->diffuse, v;
+        if (!lit(f, rho))
             continue;
-        for (size_t q = 0; q < sc->n_lights; q++) {
-            double s = sp->s[q];
-            double diff = sp->cb[q] >= 0.0 ? rho * sp->cb[q] : 0.0;
-            if (diff + s <= 0.0)
-                continue;
-            double p = it->lane_light[q * (size_t)it->n_lanes + l];
-            if (p == 0.0)
-                continue;
-            if (isnan(sp->reach[q]))
-                sp->reach[q] = light_reach(it, sp->x, (int)q);
-            p *= sp->reach[q];
-            if (p == 0.0)
-                continue;
-            collect(fr, n, 2 + (int)q, k, (diff + s) * p);
-        }
+        for (size_t q = 0; q < sc->n_lights; q++)
+            if (light_term(it, sp, rho, l, q, &v))
+                collect(fr, n, 2 + (int)q, k, v);
     }
 }
 
@@ -1513,15 +1557,26 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
  * The lanes travel as one packet and split at a lens where their optics
  * differ, as in trace_scalar; the rays of one lane are those, in the same
  * order, that tracing it alone gives. */
+static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
+                          const rs_hit *hit, int level, double weight, int f, bundle *out);
+
 static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
                       double weight, int skip, int f, bundle *out)
 {
+    rs_hit h;
+    int found = rs_scene_intersect(w->it->scene, o, d, 0.0, INFINITY, skip, &h);
+    trace_pol_hit(w, lane, n, o, d, found ? &h : NULL, level, weight, f, out);
+}
+
+/* trace_pol once the ray's hit is known (NULL: it meets nothing). */
+static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
+                          const rs_hit *hit, int level, double weight, int f, bundle *out)
+{
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
-    rs_hit h;
     size_t start = out->n;
 
-    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
+    if (!hit) {
         emit_ctx e = emit_ctx_make(out, d, -1);
         frame *fr = n > 1 ? get_frame(w, f) : NULL;
         if (fr)
@@ -1543,6 +1598,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
             emit_shared(it, fr, lane, n, 1, &e);
         return;
     }
+    const rs_hit h = *hit;
     const rs_object *ob = h.surface;
     frame *fr = get_frame(w, f);
     if (!fr)
@@ -1555,18 +1611,19 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
             return;
         int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
         memset(fr->done, 0, (size_t)n);
+        fr->qm_valid = 0;
         while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
-            uint64_t hit = ++w->splits;
+            uint64_t hit_id = ++w->splits;
             for (size_t j = 0; j < nq; j++) {
                 bundle_clear(&fr->child);
-                trace_pol(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
-                          weight * q[j].bound, -1, f + 1, &fr->child);
+                trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, j, &q[j]),
+                              level + q[j].depth, weight * q[j].bound, f + 1, &fr->child);
                 if (fr->child.n == 0)
                     continue;
                 if (m > 1) {
-                    if (gather_shared(w, fr, j, split, !ob->u.lens.desc.uniaxial, hit, q, out) != 0)
+                    if (gather_shared(w, fr, j, split, !ob->u.lens.desc.uniaxial, hit_id, q, out) != 0)
                         return;
                     continue;
                 }
@@ -1580,7 +1637,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
                         return;
                     *r = fr->res.rays[i].ray;
                     if (split)
-                        r->ch = rs_coherence_split(r->ch, hit, q[j].depth,
+                        r->ch = rs_coherence_split(r->ch, hit_id, q[j].depth,
                                                    q[j].kind != LP_KIND_REFLECT);
                 }
             }
