@@ -124,19 +124,17 @@ typedef struct colour_entry {
 
 
 
-/* A query ray's hit in the scene, kept for the next sub-packet (query_hit). */
-#define RS_QUERY_MEMO 8
+/* The scene hit of a lens hit's depth-1 query, kept for the next
+ * sub-packet (query_hit), and room for another query's hit. */
 typedef struct query_memo {
+    int valid, found;
     lp_vec3 origin, dir;
-    int found;
-    rs_hit h;
+    rs_hit h, h_other;
 } query_memo;
 
 typedef struct frame {
     lp_backward *bw;
-    query_memo qm[RS_QUERY_MEMO];
-    unsigned qm_valid; /* bit j: qm[j] holds a ray */
-    rs_hit qh_spare;
+    query_memo qm;
     bundle child;
     lp_result res;
     /* Shared gathers (gather_shared): per ray of child its group; per
@@ -516,11 +514,12 @@ static lp_ray *bundle_push(bundle *b, int lane)
     return &b->r[b->n++];
 }
 
-/* A new shared ray at the end of b, no lane having it yet; its vector in
- * *I and *has (nl entries each, all 0: a shared vector's intensity is 0
- * in every lane that does not have the ray, so that a lane's sum may add
- * the whole vector).  NULL when out of memory. */
-static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char **has)
+/* A new shared ray at the end of b; its vector in *I and *has (nl
+ * entries each).  With clear, no lane has it yet (all 0); without, the
+ * caller sets every entry.  A shared vector's intensity is 0 in every
+ * lane that does not have the ray, so that a lane's sum may add the whole
+ * vector.  NULL when out of memory. */
+static lp_ray *bundle_push_shared(bundle *b, int nl, int clear, double **I, unsigned char **has)
 {
     if (b->ns == b->scap) {
         size_t cap = b->scap ? 2 * b->scap : 8;
@@ -541,8 +540,10 @@ static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char *
     b->ns++;
     *I = b->I + s * (size_t)nl;
     *has = b->has + s * (size_t)nl;
-    memset(*has, 0, (size_t)nl);
-    memset(*I, 0, (size_t)nl * sizeof **I);
+    if (clear) {
+        memset(*has, 0, (size_t)nl);
+        memset(*I, 0, (size_t)nl * sizeof **I);
+    }
     return r;
 }
 
@@ -564,11 +565,12 @@ static lp_ray *bundle_copy(bundle *to, const bundle *from, size_t i, double scal
         double *I;
         unsigned char *has;
         size_t s = (size_t)(-1 - l);
-        p = bundle_push_shared(to, nl, &I, &has);
+        p = bundle_push_shared(to, nl, 0, &I, &has);
         if (p)
-            for (int k = 0; k < nl; k++)
-                if ((has[k] = from->has[s * (size_t)nl + (size_t)k]) != 0)
-                    I[k] = from->I[s * (size_t)nl + (size_t)k] * scale;
+            for (int k = 0; k < nl; k++) {
+                has[k] = from->has[s * (size_t)nl + (size_t)k];
+                I[k] = has[k] ? from->I[s * (size_t)nl + (size_t)k] * scale : 0.0;
+            }
     }
     if (!p)
         return NULL;
@@ -1062,24 +1064,24 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     trace_scalar_hit(w, lane, n, o, d, found ? &h : NULL, level, weight, f, out);
 }
 
-/* Where query j of a lens hit's sub-packet meets the scene (NULL:
- * nowhere), kept per query index for the next sub-packet: the
- * sub-packets of a dispersive lens share the queries that do not depend
- * on the wavelength (the reflection off the outside), and the same ray
- * meets the scene at the same point. */
-static const rs_hit *query_hit(const rs_scene *sc, frame *fr, size_t j, const lp_query *q)
+/* Where query q of a lens hit's sub-packet meets the scene (NULL:
+ * nowhere).  The reflection off the outside (depth 1) does not depend on
+ * the wavelength: its hit is kept for the next sub-packet of the same lens
+ * hit (a dispersive lens splits every lane off), which meets the scene
+ * at the same point when its ray is the same. */
+static const rs_hit *query_hit(const rs_scene *sc, frame *fr, const lp_query *q)
 {
-    if (j >= RS_QUERY_MEMO) {
-        int found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &fr->qh_spare);
-        return found ? &fr->qh_spare : NULL;
+    query_memo *m = &fr->qm;
+    if (q->depth != 1) {
+        int found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h_other);
+        return found ? &m->h_other : NULL;
     }
-    query_memo *m = &fr->qm[j];
-    if (!(fr->qm_valid >> j & 1u) || memcmp(&m->origin, &q->origin, sizeof m->origin) != 0 ||
+    if (!m->valid || memcmp(&m->origin, &q->origin, sizeof m->origin) != 0 ||
         memcmp(&m->dir, &q->dir, sizeof m->dir) != 0) {
         m->origin = q->origin;
         m->dir = q->dir;
         m->found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h);
-        fr->qm_valid |= 1u << j;
+        m->valid = 1;
     }
     return m->found ? &m->h : NULL;
 }
@@ -1107,14 +1109,14 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
         if (!fr || !lens_args(it, level, weight, &a))
             return;
         memset(fr->done, 0, (size_t)n);
-        fr->qm_valid = 0;
+        fr->qm.valid = 0;
         while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             for (int k = 0; k < m; k++)
                 fr->acc[k] = 0.0;
             for (size_t j = 0; j < nq; j++) {
-                trace_scalar_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, j, &q[j]),
+                trace_scalar_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
                                  level + q[j].depth, weight * q[j].weight, f + 1, fr->val);
                 for (int k = 0; k < m; k++)
                     fr->acc[k] += q[j].weight * fr->val[k];
@@ -1283,7 +1285,7 @@ static void emit_shared(const rs_integrator *it, frame *fr, const int *lane, int
         int source = slot == 0 ? source0 : slot == 1 ? 0 : slot; /* 2 + k: light k */
         double *I;
         unsigned char *has;
-        lp_ray *r = bundle_push_shared(out, nl, &I, &has);
+        lp_ray *r = bundle_push_shared(out, nl, 1, &I, &has);
         if (!r)
             return;
         half_ray(e, source, 0, r);
@@ -1296,7 +1298,7 @@ static void emit_shared(const rs_integrator *it, frame *fr, const int *lane, int
         /* the other half: the same intensities (indices, since a push
          * may move the vectors) */
         size_t s0 = out->ns - 1;
-        if (!(r = bundle_push_shared(out, nl, &I, &has)))
+        if (!(r = bundle_push_shared(out, nl, 0, &I, &has)))
             return;
         half_ray(e, source, 1, r);
         r->intensity = 0.5 * rad[first];
@@ -1519,7 +1521,7 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
                 int first;
                 lp_ray ray = *gr;
                 size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
-                if (!(r = bundle_push_shared(out, nl, &Io, &has)))
+                if (!(r = bundle_push_shared(out, nl, 0, &Io, &has)))
                     return -1;
                 const unsigned char *ch = c->has + s;
                 const double *cI = c->I + s;
@@ -1611,14 +1613,14 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
             return;
         int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
         memset(fr->done, 0, (size_t)n);
-        fr->qm_valid = 0;
+        fr->qm.valid = 0;
         while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             uint64_t hit_id = ++w->splits;
             for (size_t j = 0; j < nq; j++) {
                 bundle_clear(&fr->child);
-                trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, j, &q[j]),
+                trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
                               level + q[j].depth, weight * q[j].bound, f + 1, &fr->child);
                 if (fr->child.n == 0)
                     continue;
