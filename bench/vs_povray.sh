@@ -162,10 +162,15 @@ row() {
     printf '%s\n' "$line" >>"$tmp/table_s"
     printf '%-3s %-42s %8s%s\n' "$id" "" "" "$ratios" >>"$tmp/table_r"
     printf '%-3s %-42s %8s%s\n' "$id" "" "" "$wall" >>"$tmp/table_w"
+    # (one pattern per mode: in " fresnel polarized " the space between
+    # the two names can serve only one of them)
     case " $MODES " in
-    *" fresnel "*" polarized "*|*" polarized "*" fresnel "*)
-        printf '%-3s polarized / fresnel time: %s\n' "$id" \
-            "$(median_ratio "$d/polarized" "$d/fresnel" 1)" >>"$tmp/table_p" ;;
+    *" fresnel "*)
+        case " $MODES " in
+        *" polarized "*)
+            printf '%-3s polarized / fresnel time: %s\n' "$id" \
+                "$(median_ratio "$d/polarized" "$d/fresnel" 1)" >>"$tmp/table_p" ;;
+        esac ;;
     esac
 }
 
