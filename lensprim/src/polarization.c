@@ -15,7 +15,12 @@ static lp_vec3 unit_perp(lp_vec3 v, lp_vec3 dir)
 
 int lp__field_split(const lp__cvec3 *E, lp_vec3 dir, lp__linear_part part[2])
 {
-    double total = cv3_norm2(*E);
+    return lp__field_split_power(E, cv3_norm2(*E), dir, part);
+}
+
+int lp__field_split_power(const lp__cvec3 *E, double total, lp_vec3 dir,
+                          lp__linear_part part[2])
+{
     if (!(total > 0.0))
         return 0;
     if (cv3_is_real(*E)) { /* linear already: psi = 0, A = E, B = 0 */

@@ -17,5 +17,8 @@ typedef struct lp__linear_part {
  * gives one part carrying all the power.  A zero field gives 0 parts.
  * Returns the number of parts. */
 int lp__field_split(const lp__cvec3 *E, lp_vec3 dir, lp__linear_part part[2]);
+/* The same for a field whose power cv3_norm2(*E) the caller has already. */
+int lp__field_split_power(const lp__cvec3 *E, double total, lp_vec3 dir,
+                          lp__linear_part part[2]);
 
 #endif

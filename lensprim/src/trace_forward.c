@@ -89,7 +89,9 @@ lp_status lp__trace_checked(const lp_lens *lens, const lp_ray *in, const lp__opt
     /* Node 1: from the medium into the glass. */
     int tir = lp__node_setup(&node, d, h.n, o.n_medium, o.n_glass, &E);
     res->nodes++;
-    lp__node_reflect(&node, a->mode, &E, &refl);
+    lp__amp amp;
+    lp__node_project(&node, &E, &amp);
+    lp__node_reflect_amp(&node, a->mode, &amp, &refl);
     {
         lp__payload pr = pl;
         pr.kphi += refl.flip;
@@ -99,7 +101,7 @@ lp_status lp__trace_checked(const lp_lens *lens, const lp_ray *in, const lp__opt
     }
     if (tir)
         return LP_OK;
-    lp__node_transmit(&node, a->mode, &E, &trans);
+    lp__node_transmit_amp(&node, a->mode, &amp, &trans);
     E = trans.E;
     d = trans.dir;
     p = h.p;
@@ -135,14 +137,15 @@ lp_status lp__trace_checked(const lp_lens *lens, const lp_ray *in, const lp__opt
         depth++;
         tir = lp__node_setup(&node, d, h.n, o.n_glass, o.n_medium, &E);
         res->nodes++;
+        lp__node_project(&node, &E, &amp);
         if (!tir) {
-            lp__node_transmit(&node, a->mode, &E, &trans);
+            lp__node_transmit_amp(&node, a->mode, &amp, &trans);
             lp_kind kind = surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
             st = lp__leave(lens, a, res, &trans, p, &pl, depth, kind, surface, path, err);
             if (st != LP_OK)
                 return st;
         }
-        lp__node_reflect(&node, a->mode, &E, &refl);
+        lp__node_reflect_amp(&node, a->mode, &amp, &refl);
         E = refl.E;
         d = refl.dir;
         pl.kphi += refl.flip;
