@@ -1,5 +1,6 @@
 /* group_mpi.c -- the processes of a run over MPI (group.h). */
 #define _POSIX_C_SOURCE 200809L
+#include <limits.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -113,6 +114,21 @@ int mw_agree(mw_group *g, int status, int *who, char *msg, size_t msg_size)
     if (who)
         *who = first;
     return pair[0];
+}
+
+int mw_share(mw_group *g, void *data, size_t size, char *msg, size_t msg_size)
+{
+    /* In pieces of at most INT_MAX bytes (MPI counts are ints). */
+    for (size_t done = 0; done < size;) {
+        size_t n = size - done < (size_t)INT_MAX ? size - done : (size_t)INT_MAX;
+        int rc = MPI_Bcast((char *)data + done, (int)n, MPI_BYTE, 0, g->comm);
+        if (rc != MPI_SUCCESS) {
+            mpi_message(rc, "MPI_Bcast", msg, msg_size);
+            return -1;
+        }
+        done += n;
+    }
+    return 0;
 }
 
 void mw_group_end(mw_group *g)

@@ -51,6 +51,16 @@ int mw_agree(mw_group *g, int status, int *who, char *msg, size_t msg_size)
     return status;
 }
 
+int mw_share(mw_group *g, void *data, size_t size, char *msg, size_t msg_size)
+{
+    (void)g;
+    (void)data;
+    (void)size;
+    (void)msg;
+    (void)msg_size;
+    return 0;
+}
+
 void mw_group_end(mw_group *g)
 {
     free(g);

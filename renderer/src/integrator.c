@@ -131,6 +131,8 @@ typedef struct frame {
     /* Shared gathers (gather_shared): per ray of child its group; per
      * group its first ray and the range of its outputs in res. */
     size_t *g_of, *g_ray, *g_start, *g_count, g_cap;
+    lp_ray *g_rays; /* the groups' first rays, side by side */
+    size_t g_rcap;
     unsigned char *bad; /* per lane: a gather failed */
     /* A spectral packet's split at this level (n_lanes entries each). */
     int *lane, *pos;
@@ -138,9 +140,10 @@ typedef struct frame {
     unsigned char *done;
     double *reach;  /* per light: light_reach memo of one shaded point */
     double *cb, *hs; /* per light: shade_point's cosine terms and highlights */
-    /* emit_collect: per source slot (object, ambient, lights) and lane */
+    /* collect: per source slot (object, ambient, lights) and lane position */
     double *rad;
     unsigned char *got;
+    int *first; /* per slot */
 } frame;
 
 struct rs_worker {
@@ -405,10 +408,12 @@ void rs_worker_destroy(rs_worker *w)
         free(w->frames[f]->child.has);
         free(w->frames[f]->rad);
         free(w->frames[f]->got);
+        free(w->frames[f]->first);
         free(w->frames[f]->g_of);
         free(w->frames[f]->g_ray);
         free(w->frames[f]->g_start);
         free(w->frames[f]->g_count);
+        free(w->frames[f]->g_rays);
         free(w->frames[f]->bad);
         free(w->frames[f]->cb);
         free(w->frames[f]->hs);
@@ -456,8 +461,9 @@ static frame *get_frame(rs_worker *w, int f)
         fr->hs = calloc(w->it->scene->n_lights + 1, sizeof *fr->hs);
         fr->rad = calloc((w->it->scene->n_lights + 2) * n, sizeof *fr->rad);
         fr->got = calloc((w->it->scene->n_lights + 2) * n, 1);
+        fr->first = calloc(w->it->scene->n_lights + 2, sizeof *fr->first);
         if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach || !fr->bad ||
-            !fr->cb || !fr->hs || !fr->rad || !fr->got ||
+            !fr->cb || !fr->hs || !fr->rad || !fr->got || !fr->first ||
             lp_backward_create(&fr->bw, NULL) != LP_OK) {
             free(fr->lane);
             free(fr->pos);
@@ -470,6 +476,7 @@ static frame *get_frame(rs_worker *w, int f)
             free(fr->hs);
             free(fr->rad);
             free(fr->got);
+            free(fr->first);
             free(fr);
             return NULL;
         }
@@ -499,7 +506,9 @@ static lp_ray *bundle_push(bundle *b, int lane)
 }
 
 /* A new shared ray at the end of b, no lane having it yet; its vector in
- * *I and *has (nl entries each).  NULL when out of memory. */
+ * *I and *has (nl entries each, all 0: a shared vector's intensity is 0
+ * in every lane that does not have the ray, so that a lane's sum may add
+ * the whole vector).  NULL when out of memory. */
 static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char **has)
 {
     if (b->ns == b->scap) {
@@ -522,6 +531,7 @@ static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char *
     *I = b->I + s * (size_t)nl;
     *has = b->has + s * (size_t)nl;
     memset(*has, 0, (size_t)nl);
+    memset(*I, 0, (size_t)nl * sizeof **I);
     return r;
 }
 
@@ -667,12 +677,16 @@ static const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *
     return v;
 }
 
-/* The parity (0 or 1) of floor(v + 1e-10) for any v: fmod is exact at
- * every magnitude (a double beyond 2^53 is an integer), where a cast to
- * long overflows beyond 2^63; not finite: 0. */
+/* The parity (0 or 1) of floor(v + 1e-10) for any v: below 2^62 the
+ * integer's own low bit (two's complement: -3 is odd too); beyond, where
+ * a cast to long long would overflow, fmod, exact at every magnitude (a
+ * double beyond 2^53 is an integer); not finite: 0. */
 static int floor_parity(double v)
 {
-    double r = fmod(floor(v + 1e-10), 2.0);
+    double f = floor(v + 1e-10);
+    if (fabs(f) < 0x1p62)
+        return (int)((long long)f & 1);
+    double r = fmod(f, 2.0);
     return r != 0.0 && r == r; /* -1 or 1: odd; NaN: 0 */
 }
 
@@ -1143,58 +1157,107 @@ static void emit_halves(void *ctx, int source, double radiance)
     }
 }
 
-/* What the lanes of a packet emit, gathered per source slot (0: the
+/* What the lanes lane[0..n) of a packet emit, per source slot (0: the
  * object's emission or the background, 1: ambient, 2 + k: light k, the
- * order shade() emits in) and lane, to be sent as shared rays (emit_shared). */
-typedef struct collect_ctx {
-    const rs_integrator *it;
-    frame *fr;
-    int lane;
-} collect_ctx;
-
-static void emit_collect(void *ctx, int source, double radiance)
+ * order shade() emits in) and lane position k: the radiance in
+ * fr->rad[slot * n + k] where fr->got[slot * n + k] is set, the first
+ * such position in fr->first[slot] (-1: none); to be sent as shared rays
+ * (emit_shared). */
+static void collect_begin(const rs_integrator *it, frame *fr, int n)
 {
-    collect_ctx *c = ctx;
-    int nl = c->it->n_lanes, slot;
-    int n_lights = (int)c->it->scene->n_lights;
-    slot = source == 0 ? 1 : source == 1 || source >= 2 + n_lights ? 0 : source;
-    c->fr->rad[(size_t)slot * (size_t)nl + (size_t)c->lane] = radiance;
-    c->fr->got[(size_t)slot * (size_t)nl + (size_t)c->lane] = 1;
+    int n_slots = (int)it->scene->n_lights + 2;
+    memset(fr->got, 0, (size_t)n_slots * (size_t)n);
+    for (int slot = 0; slot < n_slots; slot++)
+        fr->first[slot] = -1;
+}
+
+static void collect(frame *fr, int n, int slot, int k, double radiance)
+{
+    size_t at = (size_t)slot * (size_t)n + (size_t)k;
+    fr->rad[at] = radiance;
+    fr->got[at] = 1;
+    if (fr->first[slot] < 0)
+        fr->first[slot] = k;
+}
+
+/* shade() for every lane of a packet at once, into the slots (the same
+ * values, emitted under the same conditions). */
+static void shade_packet(const rs_integrator *it, const int *lane, int n, shade_point *sp,
+                         frame *fr)
+{
+    const rs_scene *sc = it->scene;
+    const rs_finish *f = &sp->h->surface->finish;
+    collect_begin(it, fr, n);
+    for (int k = 0; k < n; k++) {
+        size_t l = (size_t)lane[k];
+        double e = sp->emission[l];
+        if (e != 0.0)
+            collect(fr, n, 0, k, e);
+        double a = sp->ambient[l];
+        if (a != 0.0)
+            collect(fr, n, 1, k, a);
+    }
+    if (sc->n_lights == 0)
+        return;
+    for (int k = 0; k < n; k++) {
+        size_t l = (size_t)lane[k];
+        double rho = sp->pigment[l] * f->diffuse;
+        if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
+            continue;
+        for (size_t q = 0; q < sc->n_lights; q++) {
+            double s = sp->s[q];
+            double diff = sp->cb[q] >= 0.0 ? rho * sp->cb[q] : 0.0;
+            if (diff + s <= 0.0)
+                continue;
+            double p = it->lane_light[q * (size_t)it->n_lanes + l];
+            if (p == 0.0)
+                continue;
+            if (isnan(sp->reach[q]))
+                sp->reach[q] = light_reach(it, sp->x, (int)q);
+            p *= sp->reach[q];
+            if (p == 0.0)
+                continue;
+            collect(fr, n, 2 + (int)q, k, (diff + s) * p);
+        }
+    }
 }
 
 /* The halves of every source slot some lane of lane[0..n) emitted
- * (fr->rad, fr->got; cleared here), as shared rays: slot by slot, each
- * lane's rays in the order emit_halves would give them. */
+ * (collect), as shared rays: slot by slot, each lane's rays in the order
+ * emit_halves would give them. */
 static void emit_shared(const rs_integrator *it, frame *fr, const int *lane, int n, int source0,
                         const emit_ctx *e)
 {
     int nl = it->n_lanes, n_slots = (int)it->scene->n_lights + 2;
+    bundle *out = e->out;
     for (int slot = 0; slot < n_slots; slot++) {
-        const double *rad = fr->rad + (size_t)slot * (size_t)nl;
-        unsigned char *got = fr->got + (size_t)slot * (size_t)nl;
-        int first = -1;
-        for (int k = 0; k < n && first < 0; k++)
-            if (got[lane[k]])
-                first = lane[k];
+        int first = fr->first[slot];
         if (first < 0)
             continue;
+        const double *rad = fr->rad + (size_t)slot * (size_t)n;
+        const unsigned char *got = fr->got + (size_t)slot * (size_t)n;
         int source = slot == 0 ? source0 : slot == 1 ? 0 : slot; /* 2 + k: light k */
-        for (int half = 0; half < 2; half++) {
-            double *I;
-            unsigned char *has;
-            lp_ray *r = bundle_push_shared(e->out, nl, &I, &has);
-            if (!r)
-                break;
-            half_ray(e, source, half, r);
-            r->intensity = 0.5 * rad[first];
-            for (int k = 0; k < n; k++)
-                if (got[lane[k]]) {
-                    has[lane[k]] = 1;
-                    I[lane[k]] = 0.5 * rad[lane[k]];
-                }
-        }
-        for (int k = 0; k < n; k++)
-            got[lane[k]] = 0;
+        double *I;
+        unsigned char *has;
+        lp_ray *r = bundle_push_shared(out, nl, &I, &has);
+        if (!r)
+            return;
+        half_ray(e, source, 0, r);
+        r->intensity = 0.5 * rad[first];
+        for (int k = first; k < n; k++)
+            if (got[k]) {
+                has[lane[k]] = 1;
+                I[lane[k]] = 0.5 * rad[k];
+            }
+        /* the other half: the same intensities (indices, since a push
+         * may move the vectors) */
+        size_t s0 = out->ns - 1;
+        if (!(r = bundle_push_shared(out, nl, &I, &has)))
+            return;
+        half_ray(e, source, 1, r);
+        r->intensity = 0.5 * rad[first];
+        memcpy(has, out->has + s0 * (size_t)nl, (size_t)nl);
+        memcpy(I, out->I + s0 * (size_t)nl, (size_t)nl * sizeof *I);
     }
 }
 
@@ -1289,6 +1352,64 @@ static int same_but_intensity(const lp_ray *a, const lp_ray *b)
         }                                                                               \
     } while (0)
 
+/* Gather the first ray of each of the n_g groups of fr->child (fr->g_ray)
+ * along query j into fr->res: group g's outputs at fr->g_start[g], their
+ * count in fr->g_count[g] (SIZE_MAX: its gather failed, no outputs).
+ * With batch (a glass lens: each bundle ray's outputs follow one another,
+ * the first of them part 0) the groups are gathered in one call, which
+ * sets up the path's nodes once for all of them; the outputs are the
+ * groups' own gathers' in order, so each group's start is found at its
+ * part 0.  Where that cannot tell them apart (a ray that gave no output,
+ * a failure), each group is gathered alone.  Returns -1 when out of
+ * memory. */
+static int gather_groups(frame *fr, size_t j, int batch, size_t n_g)
+{
+    const bundle *c = &fr->child;
+    lp_result_clear(&fr->res);
+    if (batch && n_g > 1) {
+        const lp_ray *in = c->r;
+        if (fr->g_ray[n_g - 1] != n_g - 1) { /* the groups' rays are not c->r[0..n_g) */
+            if (n_g > fr->g_rcap) {
+                lp_ray *p = realloc(fr->g_rays, n_g * sizeof *p);
+                if (!p)
+                    return -1;
+                fr->g_rays = p;
+                fr->g_rcap = n_g;
+            }
+            for (size_t g = 0; g < n_g; g++)
+                fr->g_rays[g] = c->r[fr->g_ray[g]];
+            in = fr->g_rays;
+        }
+        if (lp_backward_gather(fr->bw, j, in, n_g, &fr->res, NULL) == LP_OK) {
+            size_t g = 0;
+            for (size_t t = 0; t < fr->res.count; t++)
+                if (fr->res.rays[t].part == 0) {
+                    if (g == n_g)
+                        break;
+                    fr->g_start[g++] = t;
+                }
+            if (g == n_g) {
+                for (g = 0; g + 1 < n_g; g++)
+                    fr->g_count[g] = fr->g_start[g + 1] - fr->g_start[g];
+                fr->g_count[n_g - 1] = fr->res.count - fr->g_start[n_g - 1];
+                return 0;
+            }
+        }
+        lp_result_clear(&fr->res);
+    }
+    for (size_t g = 0; g < n_g; g++) {
+        size_t before = fr->res.count;
+        fr->g_start[g] = before;
+        if (lp_backward_gather(fr->bw, j, &c->r[fr->g_ray[g]], 1, &fr->res, NULL) != LP_OK) {
+            fr->res.count = before;
+            fr->g_count[g] = SIZE_MAX;
+        } else {
+            fr->g_count[g] = fr->res.count - before;
+        }
+    }
+    return 0;
+}
+
 /* Gather the rays of fr->child (lanes of equal optics at this lens) along
  * query j, appending the outputs to out, each with its ray's lanes.
  * Rays that differ only in intensity (a shared ray's lanes, and rays of
@@ -1298,7 +1419,7 @@ static int same_but_intensity(const lp_ray *a, const lp_ray *b)
  * own gives the same to rounding).  A lane one of whose rays fails to
  * gather gets nothing from this query, as a gather of its rays alone
  * would give.  Returns -1 when out of memory. */
-static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, uint64_t hit,
+static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch, uint64_t hit,
                          const lp_query *q, bundle *out)
 {
     const bundle *c = &fr->child;
@@ -1314,7 +1435,6 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, uint64_t 
         }
         fr->g_cap = n;
     }
-    lp_result_clear(&fr->res);
     for (size_t i = 0; i < n; i++) {
         /* lanes emit in the same order: try the group after the last one */
         size_t g = i > 0 ? fr->g_of[i - 1] + 1 : 0;
@@ -1322,22 +1442,17 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, uint64_t 
             for (g = 0; g < n_g && !same_but_intensity(&c->r[fr->g_ray[g]], &c->r[i]); g++)
                 ;
         fr->g_of[i] = g;
-        if (g < n_g)
-            continue;
-        size_t before = fr->res.count;
-        fr->g_ray[g] = i;
-        fr->g_start[g] = before;
-        if (lp_backward_gather(fr->bw, j, &c->r[i], 1, &fr->res, NULL) != LP_OK) {
-            fr->res.count = before;
-            fr->g_count[g] = SIZE_MAX;
-        } else {
-            fr->g_count[g] = fr->res.count - before;
-        }
-        n_g++;
+        if (g == n_g)
+            fr->g_ray[n_g++] = i;
     }
+    if (gather_groups(fr, j, batch, n_g) != 0)
+        return -1;
+    int any_bad = 0;
     for (size_t i = 0; i < n; i++)
-        if (fr->g_count[fr->g_of[i]] == SIZE_MAX)
+        if (fr->g_count[fr->g_of[i]] == SIZE_MAX) {
             FOR_LANES(c, i, nl, k, I, fr->bad[k] = 1);
+            any_bad = 1;
+        }
     for (size_t i = 0; i < n; i++) {
         size_t g = fr->g_of[i];
         double I0 = c->r[fr->g_ray[g]].intensity;
@@ -1357,22 +1472,27 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, uint64_t 
             } else {
                 double *Io;
                 unsigned char *has;
-                int first = -1;
+                int first;
                 lp_ray ray = *gr;
                 size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
                 if (!(r = bundle_push_shared(out, nl, &Io, &has)))
                     return -1;
+                const unsigned char *ch = c->has + s;
+                const double *cI = c->I + s;
+                double gI = gr->intensity;
+                /* every lane in one pass (no branch: it vectorizes); a
+                 * lane without the ray, or failed, gets 0 */
                 for (int k = 0; k < nl; k++) {
-                    if (!c->has[s + (size_t)k] || fr->bad[k])
-                        continue;
-                    double I = c->I[s + (size_t)k];
+                    double I = cI[k];
                     double scale = I == I0 ? 1.0 : I / I0;
-                    has[k] = 1;
-                    Io[k] = scale != 1.0 ? gr->intensity * scale : gr->intensity;
-                    if (first < 0)
-                        first = k;
+                    double v = scale != 1.0 ? gI * scale : gI;
+                    unsigned char keep = ch[k] & (unsigned char)(fr->bad[k] ^ 1);
+                    has[k] = keep;
+                    Io[k] = keep ? v : 0.0;
                 }
-                if (first < 0) { /* every lane failed: no ray */
+                for (first = 0; first < nl && !has[first]; first++)
+                    ;
+                if (first == nl) { /* every lane failed: no ray */
                     out->n--;
                     out->ns--;
                     break;
@@ -1384,8 +1504,8 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, uint64_t 
                 r->ch = rs_coherence_split(r->ch, hit, q[j].depth, q[j].kind != LP_KIND_REFLECT);
         }
     }
-    for (size_t i = 0; i < n; i++)
-        FOR_LANES(c, i, nl, k, I, fr->bad[k] = 0);
+    if (any_bad)
+        memset(fr->bad, 0, (size_t)nl);
     return 0;
 }
 
@@ -1404,6 +1524,8 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
     if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
         emit_ctx e = emit_ctx_make(out, d, -1);
         frame *fr = n > 1 ? get_frame(w, f) : NULL;
+        if (fr)
+            collect_begin(it, fr, n);
         for (int k = 0; k < n; k++) {
             double L = it->lane_background[lane[k]];
             if (L == 0.0)
@@ -1411,8 +1533,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
             if (e.wavelet < 0 && (e.wavelet = record_wavelet(w, o, d, NULL)) < 0)
                 return;
             if (fr) {
-                collect_ctx cc = {it, fr, lane[k]};
-                emit_collect(&cc, 1, L);
+                collect(fr, n, 0, k, L);
             } else {
                 e.lane = lane[k];
                 emit_halves(&e, 1, L);
@@ -1445,7 +1566,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
                 if (fr->child.n == 0)
                     continue;
                 if (m > 1) {
-                    if (gather_shared(w, fr, j, split, hit, q, out) != 0)
+                    if (gather_shared(w, fr, j, split, !ob->u.lens.desc.uniaxial, hit, q, out) != 0)
                         return;
                     continue;
                 }
@@ -1496,10 +1617,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
             e.lane = lane[0];
             shade(it, &it->lanes[lane[0]], &sp, emit_halves, &e);
         } else {
-            for (int k = 0; k < n; k++) {
-                collect_ctx cc = {it, fr, lane[k]};
-                shade(it, &it->lanes[lane[k]], &sp, emit_collect, &cc);
-            }
+            shade_packet(it, lane, n, &sp, fr);
             emit_shared(it, fr, lane, n, src_object(it, h.object), &e);
         }
     }
@@ -1523,8 +1641,16 @@ static void pol_values(rs_worker *w, lp_vec3 o, lp_vec3 d, double *L)
          * order, as rs_coherent_power forms it */
         for (int k = 0; k < nl; k++)
             L[k] = 0.0;
-        for (size_t i = 0; i < p->n; i++)
-            FOR_LANES(p, i, nl, k, I, L[k] += I);
+        for (size_t i = 0; i < p->n; i++) {
+            int l = p->lane[i];
+            if (l >= 0) {
+                L[l] += p->r[i].intensity;
+            } else { /* a lane without the ray adds 0 (bundle_push_shared) */
+                const double *I = p->I + (size_t)(-1 - l) * (size_t)nl;
+                for (int k = 0; k < nl; k++)
+                    L[k] += I[k];
+            }
+        }
         for (int k = 0; k < nl; k++)
             L[k] = L[k] > 0.0 ? L[k] : 0.0;
         return;

@@ -107,21 +107,27 @@ static int cmp_double(const void *a, const void *b)
 
 /* ---- one render ---------------------------------------------------------- */
 
+/* A reference's numbers: every process needs them (the points a scene
+ * sweeps depend on s_per_wl), so they travel as one record. */
+typedef struct sa_reference {
+    int wavelengths, depth;
+    double cutoff;
+    /* The changes of the last doubling of the wavelengths (dn), of the
+     * depth (dd) and of the cut-off divided by 100 (dc): largest pixel
+     * channel and RMSE.  u, their RMSE summed, bounds the reference's own
+     * error (see make_reference). */
+    double dn_max, dn_rmse, dd_max, dd_rmse, dc_max, dc_rmse, u;
+    double s_per_wl; /* CPU seconds per wavelength at depth 16, cut-off 1e-6 */
+    int dn_cheap;    /* the wavelength doubling was measured there */
+} sa_reference;
+
 typedef struct scene_ctx {
     const opts *o;
     char path[PATH_MAX_LEN]; /* the scene file */
     char name[256];      /* its base name without .scene */
     char dir[PATH_MAX_LEN]; /* its work directory */
     rs_image ref;
-    int ref_wavelengths, ref_depth;
-    double ref_cutoff;
-    /* The changes of the last doubling of the wavelengths (dn), of the
-     * depth (dd) and of the cut-off divided by 100 (dc): largest pixel
-     * channel and RMSE.  ref_u, their RMSE summed, bounds the reference's
-     * own error (see make_reference). */
-    double ref_dn_max, ref_dn_rmse, ref_dd_max, ref_dd_rmse, ref_dc_max, ref_dc_rmse, ref_u;
-    double ref_s_per_wl; /* CPU seconds per wavelength at depth 16, cut-off 1e-6 */
-    int ref_dn_cheap;    /* the wavelength doubling was measured there */
+    sa_reference rn; /* its numbers */
 } scene_ctx;
 
 /* Render the setting p once or several times, each run with at most
@@ -252,11 +258,11 @@ static double max_abs_diff(const rs_image *a, const rs_image *b)
  * The midpoint rule over wavelength has a step wherever a pixel's path
  * changes with the wavelength (a dispersed ray crossing a checker edge or
  * a rim), so its error falls as 1/N: the last doubling's change is about
- * the coarser render's error and twice the finer one's.  ref_u, the RMSE
+ * the coarser render's error and twice the finer one's.  rn.u, the RMSE
  * of the three last changes summed, therefore bounds the reference's own
- * RMSE from the truth; an error measured against it is known to +- ref_u
+ * RMSE from the truth; an error measured against it is known to +- rn.u
  * (the triangle inequality), and the page says a setting meets E only
- * when its error plus ref_u is at most E. */
+ * when its error plus rn.u is at most E. */
 #define REF_TOL 1e-5
 #define REF_DEPTH0 16
 #define REF_DEPTH_MAX 64
@@ -280,9 +286,9 @@ static int save_reference(scene_ctx *sc)
     if (!f)
         return -1;
     fprintf(f, "%d %d %d %d %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %d\n", sc->o->width,
-            sc->o->height, sc->ref_wavelengths, sc->ref_depth, sc->ref_cutoff, sc->ref_dn_max,
-            sc->ref_dn_rmse, sc->ref_dd_max, sc->ref_dd_rmse, sc->ref_dc_max, sc->ref_dc_rmse,
-            sc->ref_u, sc->ref_s_per_wl, sc->ref_dn_cheap);
+            sc->o->height, sc->rn.wavelengths, sc->rn.depth, sc->rn.cutoff, sc->rn.dn_max,
+            sc->rn.dn_rmse, sc->rn.dd_max, sc->rn.dd_rmse, sc->rn.dc_max, sc->rn.dc_rmse,
+            sc->rn.u, sc->rn.s_per_wl, sc->rn.dn_cheap);
     return fclose(f) == 0 ? 0 : -1;
 }
 
@@ -295,11 +301,11 @@ static int load_reference(scene_ctx *sc)
     f = fopen(path, "r");
     if (!f)
         return -1;
-    sc->ref_dn_cheap = 0; /* the last field is new: 13 fields mean 0 */
+    sc->rn.dn_cheap = 0; /* the last field is new: 13 fields mean 0 */
     int ok = fscanf(f, "%d %d %d %d %lg %lg %lg %lg %lg %lg %lg %lg %lg %d", &w, &h,
-                    &sc->ref_wavelengths, &sc->ref_depth, &sc->ref_cutoff, &sc->ref_dn_max,
-                    &sc->ref_dn_rmse, &sc->ref_dd_max, &sc->ref_dd_rmse, &sc->ref_dc_max,
-                    &sc->ref_dc_rmse, &sc->ref_u, &sc->ref_s_per_wl, &sc->ref_dn_cheap) >= 13;
+                    &sc->rn.wavelengths, &sc->rn.depth, &sc->rn.cutoff, &sc->rn.dn_max,
+                    &sc->rn.dn_rmse, &sc->rn.dd_max, &sc->rn.dd_rmse, &sc->rn.dc_max,
+                    &sc->rn.dc_rmse, &sc->rn.u, &sc->rn.s_per_wl, &sc->rn.dn_cheap) >= 13;
     fclose(f);
     if (!ok || w != sc->o->width || h != sc->o->height)
         return -1;
@@ -335,7 +341,7 @@ static int make_reference(scene_ctx *sc)
 
     if (sc->o->reuse && load_reference(sc) == 0) {
         fprintf(stderr, "speed_accuracy: %s: reference reused (%d wavelengths, depth %d)\n",
-                sc->name, sc->ref_wavelengths, sc->ref_depth);
+                sc->name, sc->rn.wavelengths, sc->rn.depth);
         return 0;
     }
     if (2 * n > sc->o->max_wavelengths) /* room for one doubling */
@@ -346,20 +352,20 @@ static int make_reference(scene_ctx *sc)
         return -1;
     seconds = p.seconds;
     do {
-        if (ref_step(sc, n, 2 * d, c, &base, &sc->ref_dd_max, &sc->ref_dd_rmse, &seconds) != 0)
+        if (ref_step(sc, n, 2 * d, c, &base, &sc->rn.dd_max, &sc->rn.dd_rmse, &seconds) != 0)
             return -1;
         fprintf(stderr, "speed_accuracy: %s: depth %d -> %d: max change %.3g, rmse %.3g\n",
-                sc->name, d, 2 * d, sc->ref_dd_max, sc->ref_dd_rmse);
+                sc->name, d, 2 * d, sc->rn.dd_max, sc->rn.dd_rmse);
         d *= 2;
-    } while (sc->ref_dd_max > REF_TOL && 2 * d <= REF_DEPTH_MAX);
+    } while (sc->rn.dd_max > REF_TOL && 2 * d <= REF_DEPTH_MAX);
     do {
-        if (ref_step(sc, n, d, c / 100.0, &base, &sc->ref_dc_max, &sc->ref_dc_rmse, &seconds) !=
+        if (ref_step(sc, n, d, c / 100.0, &base, &sc->rn.dc_max, &sc->rn.dc_rmse, &seconds) !=
             0)
             return -1;
         fprintf(stderr, "speed_accuracy: %s: cut-off %.3g -> %.3g: max change %.3g, rmse %.3g\n",
-                sc->name, c, c / 100.0, sc->ref_dc_max, sc->ref_dc_rmse);
+                sc->name, c, c / 100.0, sc->rn.dc_max, sc->rn.dc_rmse);
         c /= 100.0;
-    } while (sc->ref_dc_max > REF_TOL && c / 100.0 > 0.5 * REF_CUTOFF_MIN);
+    } while (sc->rn.dc_max > REF_TOL && c / 100.0 > 0.5 * REF_CUTOFF_MIN);
     /* The sweep's dearest polarized setting per wavelength (depth 16,
      * cut-off 1e-6): what predicts the points' times (list_points). */
     {
@@ -370,9 +376,9 @@ static int make_reference(scene_ctx *sc)
         if (render(sc, &p, 1, 0.0, &cheap) != 0)
             return -1;
         cheap_s = p.seconds;
-        sc->ref_s_per_wl = cheap_s / n;
-        sc->ref_dn_max = sc->ref_dn_rmse = INFINITY;
-        sc->ref_dn_cheap = 0;
+        sc->rn.s_per_wl = cheap_s / n;
+        sc->rn.dn_max = sc->rn.dn_rmse = INFINITY;
+        sc->rn.dn_cheap = 0;
         if (2 * n <= sc->o->max_wavelengths && 2.5 * seconds > sc->o->reference_seconds &&
             2.5 * cheap_s <= sc->o->reference_seconds) {
             /* No doubling of the reference itself fits the budget: the
@@ -382,9 +388,9 @@ static int make_reference(scene_ctx *sc)
              * adds change no pixel's topology). */
             if (ref_step(sc, 2 * n, CHEAP_DEPTH, CHEAP_CUTOFF, &cheap, &dmax, &drmse, &cheap_s) != 0)
                 return -1;
-            sc->ref_dn_max = dmax;
-            sc->ref_dn_rmse = drmse;
-            sc->ref_dn_cheap = 1;
+            sc->rn.dn_max = dmax;
+            sc->rn.dn_rmse = drmse;
+            sc->rn.dn_cheap = 1;
             fprintf(stderr,
                     "speed_accuracy: %s: wavelengths %d -> %d at depth %d, cut-off %g: max change "
                     "%.3g, rmse %.3g\n",
@@ -392,22 +398,22 @@ static int make_reference(scene_ctx *sc)
         }
         rs_image_free(&cheap);
     }
-    while (!sc->ref_dn_cheap && 2 * n <= sc->o->max_wavelengths &&
+    while (!sc->rn.dn_cheap && 2 * n <= sc->o->max_wavelengths &&
            2.5 * seconds <= sc->o->reference_seconds) {
-        if (ref_step(sc, 2 * n, d, c, &base, &sc->ref_dn_max, &sc->ref_dn_rmse, &seconds) != 0)
+        if (ref_step(sc, 2 * n, d, c, &base, &sc->rn.dn_max, &sc->rn.dn_rmse, &seconds) != 0)
             return -1;
         fprintf(stderr,
                 "speed_accuracy: %s: wavelengths %d -> %d: max change %.3g, rmse %.3g (%.3g s)\n",
-                sc->name, n, 2 * n, sc->ref_dn_max, sc->ref_dn_rmse, seconds);
+                sc->name, n, 2 * n, sc->rn.dn_max, sc->rn.dn_rmse, seconds);
         n *= 2;
-        if (sc->ref_dn_max <= REF_TOL)
+        if (sc->rn.dn_max <= REF_TOL)
             break;
     }
     sc->ref = base;
-    sc->ref_wavelengths = n;
-    sc->ref_depth = d;
-    sc->ref_cutoff = c;
-    sc->ref_u = sc->ref_dn_rmse + sc->ref_dd_rmse + sc->ref_dc_rmse;
+    sc->rn.wavelengths = n;
+    sc->rn.depth = d;
+    sc->rn.cutoff = c;
+    sc->rn.u = sc->rn.dn_rmse + sc->rn.dd_rmse + sc->rn.dc_rmse;
     return 0; /* saved by the process that gathers (reference_done) */
 }
 
@@ -511,13 +517,14 @@ typedef struct sweep {
     int n_sc;
     job_point *pts;
     long n_pts, cap;
+    long mismatch; /* rank 0: the first point that came back as another, or -1 */
 } sweep;
 
 /* What an item's result starts with; the image's floats follow. */
 typedef struct item_head {
     int width, height; /* 0 x 0: no image (a point that could not run) */
     sa_point p;        /* a point's numbers */
-    scene_ctx ref; /* a reference's numbers (not its image) */
+    sa_reference rn;   /* a reference's numbers (not its image) */
 } item_head;
 
 static int add_point(sweep *w, int scene, const sa_point *p)
@@ -559,7 +566,7 @@ static int list_points(sweep *w, int k)
                         continue;
                     /* Predicted from the reference's time per wavelength
                      * (deeper, a lower cut-off, polarized: an upper bound). */
-                    if (m != 3 && WAVELENGTHS[wl] * w->sc[k].ref_s_per_wl > w->o->point_seconds)
+                    if (m != 3 && WAVELENGTHS[wl] * w->sc[k].rn.s_per_wl > w->o->point_seconds)
                         continue;
                     sa_point_init(&p, "sweep", MODELS[m], m == 3 ? 0 : WAVELENGTHS[wl],
                                   DEPTHS[d], CUTOFFS[c]);
@@ -616,9 +623,7 @@ static int reference_run(void *user, long k, void *result, size_t *used, char *m
     if (make_reference(sc) != 0)
         return 1;
     memset(&h, 0, sizeof h);
-    h.ref = *sc;
-    h.ref.o = NULL;
-    memset(&h.ref.ref, 0, sizeof h.ref.ref);
+    h.rn = sc->rn;
     pack(&h, &sc->ref, result, used, w->o);
     rs_image_free(&sc->ref); /* rank 0 gets it back in reference_done */
     return 0;
@@ -631,18 +636,7 @@ static void reference_done(void *user, long k, const void *result, size_t size)
     item_head h;
     rs_image img = unpack(result, &h);
     (void)size;
-    sc->ref_wavelengths = h.ref.ref_wavelengths;
-    sc->ref_depth = h.ref.ref_depth;
-    sc->ref_cutoff = h.ref.ref_cutoff;
-    sc->ref_dn_max = h.ref.ref_dn_max;
-    sc->ref_dn_rmse = h.ref.ref_dn_rmse;
-    sc->ref_dd_max = h.ref.ref_dd_max;
-    sc->ref_dd_rmse = h.ref.ref_dd_rmse;
-    sc->ref_dc_max = h.ref.ref_dc_max;
-    sc->ref_dc_rmse = h.ref.ref_dc_rmse;
-    sc->ref_u = h.ref.ref_u;
-    sc->ref_s_per_wl = h.ref.ref_s_per_wl;
-    sc->ref_dn_cheap = h.ref.ref_dn_cheap;
+    sc->rn = h.rn;
     rs_image_free(&sc->ref);
     if (!img.rgb || rs_image_create(&sc->ref, img.width, img.height) != 0) {
         say("%s: the reference is lost (out of memory)%s", sc->name, "");
@@ -689,6 +683,14 @@ static int point_run(void *user, long k, void *result, size_t *used, char *msg,
     return rc == 0 ? 0 : 1;
 }
 
+/* Is a point that came back the one listed (the same setting)? */
+static int same_setting(const sa_point *a, const sa_point *b)
+{
+    return strcmp(a->scene, b->scene) == 0 && strcmp(a->kind, b->kind) == 0 &&
+           strcmp(a->model, b->model) == 0 && a->wavelengths == b->wavelengths &&
+           a->depth == b->depth && a->cutoff == b->cutoff && a->tolerance == b->tolerance;
+}
+
 static void point_done(void *user, long k, const void *result, size_t size)
 {
     sweep *w = user;
@@ -696,6 +698,11 @@ static void point_done(void *user, long k, const void *result, size_t size)
     item_head h;
     rs_image img = unpack(result, &h);
     (void)size;
+    if (!same_setting(&h.p, &jp->p)) {
+        if (w->mismatch < 0)
+            w->mismatch = k;
+        return;
+    }
     if (!img.rgb)
         return;
     jp->p = h.p;
@@ -713,19 +720,19 @@ static int write_table(const sweep *w, FILE *csv, sa_points *all)
     for (int s = 0; s < w->n_sc; s++) {
         const scene_ctx *sc = &w->sc[s];
         sa_point p;
-        sa_point_init(&p, "reference", "polarized", sc->ref_wavelengths, sc->ref_depth,
-                      sc->ref_cutoff);
+        sa_point_init(&p, "reference", "polarized", sc->rn.wavelengths, sc->rn.depth,
+                      sc->rn.cutoff);
         snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
         snprintf(p.note, sizeof p.note,
                  "%d x %d pixels; last doubling of the wavelengths%s: max %.2g rmse %.2g; of "
                  "the depth: max %.2g rmse %.2g; cut-off / 100: max %.2g rmse %.2g",
                  w->o->width, w->o->height,
-                 sc->ref_dn_cheap ? " (at depth 16 and cut-off 1e-6)" : "", sc->ref_dn_max, sc->ref_dn_rmse, sc->ref_dd_max, sc->ref_dd_rmse,
-                 sc->ref_dc_max, sc->ref_dc_rmse);
-        /* A reference's error columns: its own uncertainty (rmse: ref_u;
+                 sc->rn.dn_cheap ? " (at depth 16 and cut-off 1e-6)" : "", sc->rn.dn_max, sc->rn.dn_rmse, sc->rn.dd_max, sc->rn.dd_rmse,
+                 sc->rn.dc_max, sc->rn.dc_rmse);
+        /* A reference's error columns: its own uncertainty (rmse: rn.u;
          * max_abs: the last wavelength doubling's largest change). */
-        p.err.rmse = sc->ref_u;
-        p.err.max_abs = sc->ref_dn_max;
+        p.err.rmse = sc->rn.u;
+        p.err.max_abs = sc->rn.dn_max;
         p.err.share_visible = NAN;
         p.seconds = NAN;
         if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
@@ -755,6 +762,23 @@ static int run_sweep(mw_group *g, sweep *w, FILE *csv, sa_points *all)
     job.user = w;
     rc = mw_run(g, &job, msg, sizeof msg);
     if (rc == 0 && !w->o->references_only) {
+        /* Only rank 0 and the process that made a reference know its
+         * numbers, and the points listed depend on them: every process
+         * takes rank 0's, so that item k is the same point everywhere. */
+        sa_reference *rn = calloc((size_t)w->n_sc + 1, sizeof *rn);
+        for (int s = 0; rn && s < w->n_sc; s++)
+            rn[s] = w->sc[s].rn;
+        rc = rn ? 0 : -1;
+        if (rc != 0)
+            snprintf(msg, sizeof msg, "out of memory");
+        rc = mw_agree(g, rc, NULL, msg, sizeof msg);
+        if (rc == 0)
+            rc = mw_share(g, rn, (size_t)w->n_sc * sizeof *rn, msg, sizeof msg);
+        for (int s = 0; rc == 0 && s < w->n_sc; s++)
+            w->sc[s].rn = rn[s];
+        free(rn);
+    }
+    if (rc == 0 && !w->o->references_only) {
         for (int s = 0; s < w->n_sc; s++)
             if (list_points(w, s) != 0) {
                 snprintf(msg, sizeof msg, "out of memory");
@@ -766,6 +790,11 @@ static int run_sweep(mw_group *g, sweep *w, FILE *csv, sa_points *all)
         job.done = point_done;
         if (rc == 0)
             rc = mw_run(g, &job, msg, sizeof msg);
+        if (rc == 0 && w->mismatch >= 0) {
+            snprintf(msg, sizeof msg, "point %ld came back as another setting: the processes "
+                     "listed different points", w->mismatch);
+            rc = 1;
+        }
     }
     if (rc != 0) {
         if (msg[0] && w->o->rank == 0)
@@ -911,6 +940,7 @@ int main(int argc, char **argv)
         struct dirent *de;
         memset(&w, 0, sizeof w);
         w.o = &o;
+        w.mismatch = -1;
         if (!dir) {
             say("%s: cannot list: %s", o.scenes, strerror(errno));
             rc = 1;

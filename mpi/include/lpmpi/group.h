@@ -41,6 +41,11 @@ int mw_group_local_size(const mw_group *g);
  * not agree on is returned as -1 with a message. */
 int mw_agree(mw_group *g, int status, int *who, char *msg, size_t msg_size);
 
+/* Collective: rank 0's size bytes at data replace every other process's
+ * (size must be the same on every process).  Returns 0, or -1 with a
+ * message (the MPI library could not send them). */
+int mw_share(mw_group *g, void *data, size_t size, char *msg, size_t msg_size);
+
 /* End this process's part (MPI_Finalize) and free g (NULL is harmless).
  * Every process must call it once, after its last collective call. */
 void mw_group_end(mw_group *g);
