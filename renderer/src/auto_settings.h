@@ -29,7 +29,8 @@
  *               the floor: interference makes a faint branch matter.
  *   wavelengths a ladder 4, 8, 16 ... on the probe, in the chosen model and
  *               cut-off: the first N whose change to 2N, doubled, fits in
- *               what the model and cut-off leave of E (at most 1024).
+ *               what the model and cut-off leave of E (at most 16384,
+ *               what lensrender takes).
  *               Without dispersion the first rung stands; through
  *               dispersive glass the integrand over wavelength has a step
  *               at every edge a pixel's spectrum crosses and the error
@@ -41,13 +42,22 @@
  *               limit matters only where light is not attenuated (TIR
  *               traps, mirror pairs).
  *
- * The probe: one in 4 of the pixels whose camera ray meets a lens
- * (through polarizers, which are thin sheets) and one in 32 of the others
- * (at least 24 and 8, at most 1024 of each, lens pixels at most one in
- * 16 of the image), each group weighted by its
- * share of the image.  Its cost, wavelength samples summed over its
- * renders, is returned; at 32 x 24 it is measured 0.2-0.45 of the chosen
- * render's, less at larger sizes.  Nothing here renders the reference.
+ * The probe: a pilot first -- the middle pixel of every 2 x 2 cell (every
+ * pixel of an image under 4 x 192 pixels; larger cells past 4096), in rgb,
+ * or polarized at one wavelength where the scene needs that model -- marks
+ * the brightest and (rgb) the most saturated pixels, 6 of each or one in
+ * 64 of the pilot's, each standing for its cell: a regular subsample
+ * misses the few pixels that carry most of an error (a cut-off's dropped
+ * branch under a bright highlight, a wavelength count's error on a
+ * saturated colour).  The marked pixels are in every probe render; then
+ * one in 4 of the other pixels whose camera ray meets a lens (through
+ * polarizers, which are thin sheets) and one in 32 of the rest (at least
+ * 24 and 8, at most 1024 of each, lens pixels at most one in 16 of the
+ * image), each group weighted by its share of the image.  Its cost,
+ * wavelength samples summed over its renders (a pilot pixel in rgb counts
+ * one), is returned; at 32 x 24 it is measured 0.38-0.56 of the chosen
+ * render's where that is cheap, less at larger sizes.  Nothing here renders
+ * the reference.
  *
  * No printing, no global state.  The caller's --depth, --wavelengths and
  * --cutoff, when given, are kept and the rest chosen around them. */
