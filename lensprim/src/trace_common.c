@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include "error.h"
+#include "glass_internal.h"
 #include "polarization.h"
 #include "result.h"
 #include "trace.h"
@@ -20,7 +21,7 @@ lp_status lp__optics_at(const lp_lens *lens, double lambda_nm, lp__optics *o, lp
     o->lambda_nm = lambda_nm;
     o->n_glass = lp_glass_index(g, lambda_nm);
     o->n_medium = lp_glass_index(&d->medium, lambda_nm);
-    o->alpha = lp_glass_absorption(g, lambda_nm);
+    o->alpha = lp__glass_absorption_ln(g, lens->ln_tau, lambda_nm);
     if (!isfinite(o->n_glass) || !(o->n_glass > 0.0))
         return lp__fail(err, LP_ERROR_INVALID_GLASS, "glass %s has no valid index at %g nm",
                         g->name, lambda_nm);
@@ -106,7 +107,7 @@ static lp_status emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3
                             lp_kind kind, int surface, uint64_t path, lp_error *err)
 {
     lp__linear_part part[2];
-    int n = lp__field_split_power(E, power, x->d, part);
+    int n = lp__field_split(E, power, x->d, part);
 
     for (int k = 0; k < n; k++) {
         lp_out_ray *o = lp__result_push(res);

@@ -42,18 +42,23 @@ lp_status lp__ray_failed(lp_error *err, lp_status st, size_t i)
     return st;
 }
 
+/* Trace one ray; *o holds the optics at the wavelength *o_valid says
+ * (NaN: none yet) and is recomputed only when the ray's differs. */
 static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace_args *a,
-                           lp_result *res, lp_error *err)
+                           lp__optics *o, double *o_valid, lp_result *res, lp_error *err)
 {
     lp_vec3 dw = {0, 0, 0}, vpw = dw;
-    lp__optics o;
     lp_status st;
 
     if ((st = lp__ray_check(in, &dw, &vpw, err)) != LP_OK)
         return st;
-    if ((st = lp__optics_at(lens, in->lambda_nm, &o, err)) != LP_OK)
-        return st;
-    return lp__trace_checked(lens, in, &o, lp__to_local_point(lens, in->origin),
+    if (!(in->lambda_nm == *o_valid)) {
+        *o_valid = NAN;
+        if ((st = lp__optics_at(lens, in->lambda_nm, o, err)) != LP_OK)
+            return st;
+        *o_valid = in->lambda_nm;
+    }
+    return lp__trace_checked(lens, in, o, lp__to_local_point(lens, in->origin),
                              lp__to_local_dir(lens, dw), lp__to_local_dir(lens, vpw), a, res,
                              err);
 }
@@ -165,7 +170,9 @@ lp_status lp_trace_forward(const lp_lens *lens, const lp_ray *in, const lp_trace
     lp_result_clear(out);
     if ((st = lp__args_resolve(args, &a, err)) != LP_OK)
         return st;
-    if ((st = trace_one(lens, in, &a, out, err)) != LP_OK)
+    lp__optics o;
+    double o_valid = NAN;
+    if ((st = trace_one(lens, in, &a, &o, &o_valid, out, err)) != LP_OK)
         return st;
     lp__ok(err);
     return LP_OK;
@@ -183,9 +190,11 @@ lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in, size_t n,
     lp_result_clear(out);
     if ((st = lp__args_resolve(args, &a, err)) != LP_OK)
         return st;
+    lp__optics o; /* shared by consecutive rays of one wavelength */
+    double o_valid = NAN;
     for (size_t i = 0; i < n; i++) {
         offsets[i] = out->count;
-        if ((st = trace_one(lens, &in[i], &a, out, err)) != LP_OK)
+        if ((st = trace_one(lens, &in[i], &a, &o, &o_valid, out, err)) != LP_OK)
             return lp__ray_failed(err, st, i);
     }
     offsets[n] = out->count;
