@@ -124,8 +124,17 @@ typedef struct colour_entry {
 
 
 
+/* The scene hit of a lens hit's depth-1 query, kept for the next
+ * sub-packet (query_hit), and room for another query's hit. */
+typedef struct query_memo {
+    int valid, found;
+    lp_vec3 origin, dir;
+    rs_hit h, h_other;
+} query_memo;
+
 typedef struct frame {
     lp_backward *bw;
+    query_memo qm;
     bundle child;
     lp_result res;
     /* Shared gathers (gather_shared): per ray of child its group; per
@@ -505,11 +514,12 @@ static lp_ray *bundle_push(bundle *b, int lane)
     return &b->r[b->n++];
 }
 
-/* A new shared ray at the end of b, no lane having it yet; its vector in
- * *I and *has (nl entries each, all 0: a shared vector's intensity is 0
- * in every lane that does not have the ray, so that a lane's sum may add
- * the whole vector).  NULL when out of memory. */
-static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char **has)
+/* A new shared ray at the end of b; its vector in *I and *has (nl
+ * entries each).  With clear, no lane has it yet (all 0); without, the
+ * caller sets every entry.  A shared vector's intensity is 0 in every
+ * lane that does not have the ray, so that a lane's sum may add the whole
+ * vector.  NULL when out of memory. */
+static lp_ray *bundle_push_shared(bundle *b, int nl, int clear, double **I, unsigned char **has)
 {
     if (b->ns == b->scap) {
         size_t cap = b->scap ? 2 * b->scap : 8;
@@ -530,8 +540,10 @@ static lp_ray *bundle_push_shared(bundle *b, int nl, double **I, unsigned char *
     b->ns++;
     *I = b->I + s * (size_t)nl;
     *has = b->has + s * (size_t)nl;
-    memset(*has, 0, (size_t)nl);
-    memset(*I, 0, (size_t)nl * sizeof **I);
+    if (clear) {
+        memset(*has, 0, (size_t)nl);
+        memset(*I, 0, (size_t)nl * sizeof **I);
+    }
     return r;
 }
 
@@ -553,11 +565,12 @@ static lp_ray *bundle_copy(bundle *to, const bundle *from, size_t i, double scal
         double *I;
         unsigned char *has;
         size_t s = (size_t)(-1 - l);
-        p = bundle_push_shared(to, nl, &I, &has);
+        p = bundle_push_shared(to, nl, 0, &I, &has);
         if (p)
-            for (int k = 0; k < nl; k++)
-                if ((has[k] = from->has[s * (size_t)nl + (size_t)k]) != 0)
-                    I[k] = from->I[s * (size_t)nl + (size_t)k] * scale;
+            for (int k = 0; k < nl; k++) {
+                has[k] = from->has[s * (size_t)nl + (size_t)k];
+                I[k] = has[k] ? from->I[s * (size_t)nl + (size_t)k] * scale : 0.0;
+            }
     }
     if (!p)
         return NULL;
@@ -604,11 +617,6 @@ static double band_light_eval(const rs_integrator *it, const band *b, int k)
     return rs_spectrum_emission_norm(&s, it->light_norm[k], b->lambda);
 }
 
-/* The power of light k in band b (one of it->lanes), from the table. */
-static double band_light(const rs_integrator *it, const band *b, int k)
-{
-    return it->lane_light[(size_t)k * (size_t)it->n_lanes + (size_t)(b - it->lanes)];
-}
 
 /* The tables of light and background per lane (see struct rs_integrator). */
 static int make_lane_tables(rs_integrator *it)
@@ -904,15 +912,42 @@ static void shade_begin(rs_worker *w, const int *lane, int n, const rs_hit *h, l
  * (N.L)^brilliance plus the highlights.  Calls emit(source, radiance) for
  * each non-zero source.  The lanes of a packet share sp, and with it
  * their shadow rays. */
+/* What light k adds at sp in lane `lane` to a surface of diffuse
+ * reflectance rho there: 1 and the radiance in *v, or 0 where it adds
+ * nothing (behind the surface, dark in the lane, or in shadow). */
+static int light_term(const rs_integrator *it, shade_point *sp, double rho, size_t lane, size_t k,
+                      double *v)
+{
+    double s = sp->s[k];
+    double diff = sp->cb[k] >= 0.0 ? rho * sp->cb[k] : 0.0;
+    if (diff + s <= 0.0)
+        return 0;
+    double p = it->lane_light[k * (size_t)it->n_lanes + lane];
+    if (p == 0.0)
+        return 0;
+    if (isnan(sp->reach[k]))
+        sp->reach[k] = light_reach(it, sp->x, (int)k);
+    p *= sp->reach[k];
+    if (p == 0.0)
+        return 0;
+    *v = (diff + s) * p;
+    return 1;
+}
+
+/* Whether a surface of diffuse reflectance rho reflects any light. */
+static int lit(const rs_finish *f, double rho)
+{
+    return !(rho == 0.0 && f->phong == 0.0 && f->specular == 0.0);
+}
+
 static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_fn emit,
                   void *ctx)
 {
     const rs_scene *sc = it->scene;
     const rs_hit *h = sp->h;
-    const rs_object *o = h->surface;
-    const rs_finish *f = &o->finish;
+    const rs_finish *f = &h->surface->finish;
     size_t lane = (size_t)(b - it->lanes);
-    double e = sp->emission[lane];
+    double e = sp->emission[lane], v;
     if (e != 0.0)
         emit(ctx, src_object(it, h->object), e);
     double a = sp->ambient[lane];
@@ -921,23 +956,11 @@ static void shade(const rs_integrator *it, const band *b, shade_point *sp, emit_
     if (sc->n_lights == 0)
         return;
     double rho = sp->pigment[lane] * f->diffuse;
-    if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
+    if (!lit(f, rho))
         return;
-    for (size_t k = 0; k < sc->n_lights; k++) {
-        double s = sp->s[k];
-        double diff = sp->cb[k] >= 0.0 ? rho * sp->cb[k] : 0.0;
-        if (diff + s <= 0.0)
-            continue;
-        double p = band_light(it, b, (int)k);
-        if (p == 0.0)
-            continue;
-        if (isnan(sp->reach[k]))
-            sp->reach[k] = light_reach(it, sp->x, (int)k);
-        p *= sp->reach[k];
-        if (p == 0.0)
-            continue;
-        emit(ctx, src_light(it, (int)k), (diff + s) * p);
-    }
+    for (size_t k = 0; k < sc->n_lights; k++)
+        if (light_term(it, sp, rho, lane, k, &v))
+            emit(ctx, src_light(it, (int)k), v);
 }
 
 /* The mirror reflectivity of a surface in each lane lane[k] of a packet
@@ -1030,18 +1053,52 @@ static int lens_next(const rs_integrator *it, frame *fr, const rs_object *ob, in
  * along the ray, into out[0..n).  The lanes travel as one spectral packet
  * (packet.h) and split at a lens where their optics differ; each lane's
  * sums are formed in the same order as if it were traced alone. */
+static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
+                             const rs_hit *hit, int level, double weight, int f, double *out);
+
 static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
                          double weight, int skip, int f, double *out)
 {
+    rs_hit h;
+    int found = rs_scene_intersect(w->it->scene, o, d, 0.0, INFINITY, skip, &h);
+    trace_scalar_hit(w, lane, n, o, d, found ? &h : NULL, level, weight, f, out);
+}
+
+/* Where query q of a lens hit's sub-packet meets the scene (NULL:
+ * nowhere).  The reflection off the outside (depth 1) does not depend on
+ * the wavelength: its hit is kept for the next sub-packet of the same lens
+ * hit (a dispersive lens splits every lane off), which meets the scene
+ * at the same point when its ray is the same. */
+static const rs_hit *query_hit(const rs_scene *sc, frame *fr, const lp_query *q)
+{
+    query_memo *m = &fr->qm;
+    if (q->depth != 1) {
+        int found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h_other);
+        return found ? &m->h_other : NULL;
+    }
+    if (!m->valid || memcmp(&m->origin, &q->origin, sizeof m->origin) != 0 ||
+        memcmp(&m->dir, &q->dir, sizeof m->dir) != 0) {
+        m->origin = q->origin;
+        m->dir = q->dir;
+        m->found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h);
+        m->valid = 1;
+    }
+    return m->found ? &m->h : NULL;
+}
+
+/* trace_scalar once the ray's hit is known (NULL: it meets nothing). */
+static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
+                             const rs_hit *hit, int level, double weight, int f, double *out)
+{
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
-    rs_hit h;
 
-    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
+    if (!hit) {
         for (int k = 0; k < n; k++)
             out[k] = it->lane_background[lane[k]];
         return;
     }
+    const rs_hit h = *hit;
     for (int k = 0; k < n; k++)
         out[k] = 0.0;
     const rs_object *ob = h.surface;
@@ -1052,14 +1109,15 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
         if (!fr || !lens_args(it, level, weight, &a))
             return;
         memset(fr->done, 0, (size_t)n);
+        fr->qm.valid = 0;
         while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             for (int k = 0; k < m; k++)
                 fr->acc[k] = 0.0;
             for (size_t j = 0; j < nq; j++) {
-                trace_scalar(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
-                             weight * q[j].weight, -1, f + 1, fr->val);
+                trace_scalar_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
+                                 level + q[j].depth, weight * q[j].weight, f + 1, fr->val);
                 for (int k = 0; k < m; k++)
                     fr->acc[k] += q[j].weight * fr->val[k];
             }
@@ -1201,24 +1259,12 @@ static void shade_packet(const rs_integrator *it, const int *lane, int n, shade_
         return;
     for (int k = 0; k < n; k++) {
         size_t l = (size_t)lane[k];
-        double rho = sp->pigment[l] * f->diffuse;
-        if (rho == 0.0 && f->phong == 0.0 && f->specular == 0.0)
+        double rho = sp->pigment[l] * f->diffuse, v;
+        if (!lit(f, rho))
             continue;
-        for (size_t q = 0; q < sc->n_lights; q++) {
-            double s = sp->s[q];
-            double diff = sp->cb[q] >= 0.0 ? rho * sp->cb[q] : 0.0;
-            if (diff + s <= 0.0)
-                continue;
-            double p = it->lane_light[q * (size_t)it->n_lanes + l];
-            if (p == 0.0)
-                continue;
-            if (isnan(sp->reach[q]))
-                sp->reach[q] = light_reach(it, sp->x, (int)q);
-            p *= sp->reach[q];
-            if (p == 0.0)
-                continue;
-            collect(fr, n, 2 + (int)q, k, (diff + s) * p);
-        }
+        for (size_t q = 0; q < sc->n_lights; q++)
+            if (light_term(it, sp, rho, l, q, &v))
+                collect(fr, n, 2 + (int)q, k, v);
     }
 }
 
@@ -1239,7 +1285,7 @@ static void emit_shared(const rs_integrator *it, frame *fr, const int *lane, int
         int source = slot == 0 ? source0 : slot == 1 ? 0 : slot; /* 2 + k: light k */
         double *I;
         unsigned char *has;
-        lp_ray *r = bundle_push_shared(out, nl, &I, &has);
+        lp_ray *r = bundle_push_shared(out, nl, 1, &I, &has);
         if (!r)
             return;
         half_ray(e, source, 0, r);
@@ -1252,7 +1298,7 @@ static void emit_shared(const rs_integrator *it, frame *fr, const int *lane, int
         /* the other half: the same intensities (indices, since a push
          * may move the vectors) */
         size_t s0 = out->ns - 1;
-        if (!(r = bundle_push_shared(out, nl, &I, &has)))
+        if (!(r = bundle_push_shared(out, nl, 0, &I, &has)))
             return;
         half_ray(e, source, 1, r);
         r->intensity = 0.5 * rad[first];
@@ -1475,7 +1521,7 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
                 int first;
                 lp_ray ray = *gr;
                 size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
-                if (!(r = bundle_push_shared(out, nl, &Io, &has)))
+                if (!(r = bundle_push_shared(out, nl, 0, &Io, &has)))
                     return -1;
                 const unsigned char *ch = c->has + s;
                 const double *cI = c->I + s;
@@ -1513,15 +1559,26 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
  * The lanes travel as one packet and split at a lens where their optics
  * differ, as in trace_scalar; the rays of one lane are those, in the same
  * order, that tracing it alone gives. */
+static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
+                          const rs_hit *hit, int level, double weight, int f, bundle *out);
+
 static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
                       double weight, int skip, int f, bundle *out)
 {
+    rs_hit h;
+    int found = rs_scene_intersect(w->it->scene, o, d, 0.0, INFINITY, skip, &h);
+    trace_pol_hit(w, lane, n, o, d, found ? &h : NULL, level, weight, f, out);
+}
+
+/* trace_pol once the ray's hit is known (NULL: it meets nothing). */
+static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
+                          const rs_hit *hit, int level, double weight, int f, bundle *out)
+{
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
-    rs_hit h;
     size_t start = out->n;
 
-    if (!rs_scene_intersect(sc, o, d, 0.0, INFINITY, skip, &h)) {
+    if (!hit) {
         emit_ctx e = emit_ctx_make(out, d, -1);
         frame *fr = n > 1 ? get_frame(w, f) : NULL;
         if (fr)
@@ -1543,6 +1600,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
             emit_shared(it, fr, lane, n, 1, &e);
         return;
     }
+    const rs_hit h = *hit;
     const rs_object *ob = h.surface;
     frame *fr = get_frame(w, f);
     if (!fr)
@@ -1555,18 +1613,19 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
             return;
         int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
         memset(fr->done, 0, (size_t)n);
+        fr->qm.valid = 0;
         while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
-            uint64_t hit = ++w->splits;
+            uint64_t hit_id = ++w->splits;
             for (size_t j = 0; j < nq; j++) {
                 bundle_clear(&fr->child);
-                trace_pol(w, fr->lane, m, q[j].origin, q[j].dir, level + q[j].depth,
-                          weight * q[j].bound, -1, f + 1, &fr->child);
+                trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
+                              level + q[j].depth, weight * q[j].bound, f + 1, &fr->child);
                 if (fr->child.n == 0)
                     continue;
                 if (m > 1) {
-                    if (gather_shared(w, fr, j, split, !ob->u.lens.desc.uniaxial, hit, q, out) != 0)
+                    if (gather_shared(w, fr, j, split, !ob->u.lens.desc.uniaxial, hit_id, q, out) != 0)
                         return;
                     continue;
                 }
@@ -1580,7 +1639,7 @@ static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d
                         return;
                     *r = fr->res.rays[i].ray;
                     if (split)
-                        r->ch = rs_coherence_split(r->ch, hit, q[j].depth,
+                        r->ch = rs_coherence_split(r->ch, hit_id, q[j].depth,
                                                    q[j].kind != LP_KIND_REFLECT);
                 }
             }

@@ -121,6 +121,36 @@ static FILE *open_temp(const char *tmp)
     return NULL;
 }
 
+/* writer on f, its message prefixed with what path failed. */
+static int run_writer(FILE *f, const char *path, const rs_image *img, stream_writer writer,
+                      char *msg, size_t msg_size)
+{
+    int rc = writer(f, img, msg, msg_size);
+    if (rc != 0 && msg && msg_size > 0) {
+        char why[256];
+        snprintf(why, sizeof why, "%s", msg);
+        set_msg(msg, msg_size, "cannot write %s: %s", path, why);
+    }
+    return rc;
+}
+
+static int write_in_place(const char *path, const rs_image *img, stream_writer writer,
+                          char *msg, size_t msg_size)
+{
+    FILE *f = fopen(path, "wb");
+    int rc;
+    if (!f) {
+        set_msg(msg, msg_size, "cannot open %s: %s", path, strerror(errno));
+        return -1;
+    }
+    rc = run_writer(f, path, img, writer, msg, msg_size);
+    if (fclose(f) != 0 && rc == 0) {
+        set_msg(msg, msg_size, "cannot write %s: %s", path, strerror(errno));
+        rc = -1;
+    }
+    return rc;
+}
+
 static int write_atomic(const char *path, const rs_image *img,
                         stream_writer writer, char *msg, size_t msg_size)
 {
@@ -137,6 +167,13 @@ static int write_atomic(const char *path, const rs_image *img,
         set_msg(msg, msg_size, "%s: empty or invalid image", path);
         return -1;
     }
+    {
+        /* A device or a pipe (/dev/null, /dev/stdout, a FIFO) is written
+         * in place: a file renamed over it would replace it. */
+        struct stat st;
+        if (stat(path, &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode))
+            return write_in_place(path, img, writer, msg, msg_size);
+    }
     len = strlen(path) + 32;
     tmp = malloc(len);
     if (!tmp) {
@@ -151,12 +188,7 @@ static int write_atomic(const char *path, const rs_image *img,
         free(tmp);
         return -1;
     }
-    rc = writer(f, img, msg, msg_size);
-    if (rc != 0 && msg && msg_size > 0) {
-        char why[256];
-        snprintf(why, sizeof why, "%s", msg);
-        set_msg(msg, msg_size, "cannot write %s: %s", path, why);
-    }
+    rc = run_writer(f, path, img, writer, msg, msg_size);
     if (rc == 0 && fflush(f) != 0) {
         set_msg(msg, msg_size, "cannot write %s: %s", tmp, strerror(errno));
         rc = -1;

@@ -25,6 +25,7 @@
 
 #include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -451,6 +452,39 @@ static uint32_t float_bits(float f)
     return u;
 }
 
+/* A FIFO (as /dev/null or /dev/stdout: not a regular file) is written in
+ * place and stays a FIFO; no temporary file beside it. */
+static void test_special_file(void)
+{
+    char path[1200], msg[256] = "";
+    unsigned char buf[4096];
+    rs_image img;
+    struct stat st;
+    CHECK(rs_image_create(&img, 4, 3) == 0, "create 4x3");
+    for (size_t i = 0; i < 36; i++)
+        img.rgb[i] = (float)(i / 40.0);
+    path_in(path, sizeof path, "pipe.png");
+    unlink(path);
+    CHECK(mkfifo(path, 0600) == 0, "mkfifo %s: %s", path, strerror(errno));
+    /* a reader first, so that the writer's open does not wait; the image
+     * is far smaller than a pipe's buffer */
+    int rd = open(path, O_RDONLY | O_NONBLOCK);
+    CHECK(rd >= 0, "open the FIFO for reading: %s", strerror(errno));
+    CHECK(rs_png_write(path, &img, msg, sizeof msg) == 0, "PNG into a FIFO: %s", msg);
+    CHECK(stat(path, &st) == 0 && S_ISFIFO(st.st_mode), "the FIFO was replaced by a file");
+    ssize_t n = rd >= 0 ? read(rd, buf, sizeof buf) : -1;
+    CHECK(n > 8 && memcmp(buf, "\x89PNG", 4) == 0, "the FIFO got no PNG (%ld bytes)", (long)n);
+    CHECK(rs_pfm_write(path, &img, msg, sizeof msg) == 0, "PFM into a FIFO: %s", msg);
+    n = rd >= 0 ? read(rd, buf, sizeof buf) : -1;
+    CHECK(n > 2 && buf[0] == 'P' && buf[1] == 'F', "the FIFO got no PFM (%ld bytes)", (long)n);
+    CHECK(stat(path, &st) == 0 && S_ISFIFO(st.st_mode), "the FIFO was replaced by a PFM");
+    CHECK(count_temp_files() == 0, "%d temporary files left in %s", count_temp_files(), tmpdir);
+    if (rd >= 0)
+        close(rd);
+    unlink(path);
+    rs_image_free(&img);
+}
+
 static void test_pfm(void)
 {
     char path[1200], msg[256] = "";
@@ -652,6 +686,7 @@ int main(void)
     test_png16();
     test_png_read_types();
     test_atomic();
+    test_special_file();
     test_pfm();
     test_metrics();
     return check_finish("test_image");

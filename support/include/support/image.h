@@ -14,7 +14,10 @@
  * left untouched; a reader never sees a half-written file.  (The
  * temporary file is created exclusively; a stale regular file or symlink
  * of that name is replaced, anything else there makes the write fail.
- * When path is a symlink, the link itself is replaced.) */
+ * When path is a symlink, the link itself is replaced.)  A path that
+ * exists and is neither a regular file nor a directory -- a device such
+ * as /dev/null or /dev/stdout, a FIFO -- is written in place instead,
+ * with no temporary file: renaming one over it would replace it. */
 #ifndef RS_IMAGE_H
 #define RS_IMAGE_H
 
