@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "error.h"
+#include "glass_internal.h"
 
 /* The visible window checked when a glass has no data range. */
 #define CHECK_LO_NM 380.0
@@ -72,9 +73,16 @@ double lp_glass_index(const lp_glass *glass, double lambda_nm)
     return NAN;
 }
 
-double lp_glass_absorption(const lp_glass *glass, double lambda_nm)
+/* log(tau[i]): from the table of logarithms when there is one. */
+static double ln_tau_at(const lp_glass *glass, const double *ln_tau, int i)
 {
-    const double *x, *tau;
+    return ln_tau ? ln_tau[i] : log(glass->tau[i]);
+}
+
+double lp__glass_absorption_ln(const lp_glass *glass, const double *ln_tau_table,
+                               double lambda_nm)
+{
+    const double *x;
     double t, ln_tau;
     int n, lo, hi;
 
@@ -86,12 +94,11 @@ double lp_glass_absorption(const lp_glass *glass, double lambda_nm)
     if (n > LP_GLASS_TABLE_MAX || !(glass->tau_thickness_mm > 0.0))
         return NAN; /* not a usable table; lp_glass_check says why */
     x = glass->tau_lambda_nm;
-    tau = glass->tau;
 
     if (lambda_nm <= x[0]) {
-        ln_tau = log(tau[0]);
+        ln_tau = ln_tau_at(glass, ln_tau_table, 0);
     } else if (lambda_nm >= x[n - 1]) {
-        ln_tau = log(tau[n - 1]);
+        ln_tau = ln_tau_at(glass, ln_tau_table, n - 1);
     } else {
         /* x[lo] < lambda_nm < x[hi], hi == lo + 1 */
         lo = 0;
@@ -104,9 +111,22 @@ double lp_glass_absorption(const lp_glass *glass, double lambda_nm)
                 hi = mid;
         }
         t = (lambda_nm - x[lo]) / (x[hi] - x[lo]);
-        ln_tau = (1.0 - t) * log(tau[lo]) + t * log(tau[hi]);
+        ln_tau = (1.0 - t) * ln_tau_at(glass, ln_tau_table, lo) +
+                 t * ln_tau_at(glass, ln_tau_table, hi);
     }
     return -ln_tau / glass->tau_thickness_mm;
+}
+
+void lp__glass_ln_tau(const lp_glass *glass, double ln_tau[LP_GLASS_TABLE_MAX])
+{
+    int n = glass->n_tau < LP_GLASS_TABLE_MAX ? glass->n_tau : LP_GLASS_TABLE_MAX;
+    for (int i = 0; i < LP_GLASS_TABLE_MAX; i++)
+        ln_tau[i] = i < n ? log(glass->tau[i]) : 0.0;
+}
+
+double lp_glass_absorption(const lp_glass *glass, double lambda_nm)
+{
+    return lp__glass_absorption_ln(glass, NULL, lambda_nm);
 }
 
 int lp_glass_covers(const lp_glass *glass, double lambda_nm)

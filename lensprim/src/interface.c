@@ -63,19 +63,18 @@ double lp__node_reflectance(const lp__node *node, lp_mode mode)
     return 0.5 * (node->f.Rs + node->f.Rp);
 }
 
-/* E on the s and p axes of the incident wave; 1 when both are real. */
-static int project(const lp__node *node, const lp__cvec3 *E, double complex *es,
-                   double complex *ep)
+void lp__node_project(const lp__node *node, const lp__cvec3 *E, lp__amp *out)
 {
     if (cv3_is_real(*E)) {
         lp_vec3 e = cv3_re(*E);
-        *es = v3_dot(e, node->s);
-        *ep = v3_dot(e, node->p);
-        return 1;
+        out->es = v3_dot(e, node->s);
+        out->ep = v3_dot(e, node->p);
+        out->real = 1;
+        return;
     }
-    *es = cv3_dot_real(*E, node->s);
-    *ep = cv3_dot_real(*E, node->p);
-    return 0;
+    out->es = cv3_dot_real(*E, node->s);
+    out->ep = cv3_dot_real(*E, node->p);
+    out->real = 0;
 }
 
 /* a u + b w, in real arithmetic when a and b are real. */
@@ -86,12 +85,13 @@ static lp__cvec3 combine(int real, double complex a, lp_vec3 u, double complex b
     return cv3_combine(a, u, b, w);
 }
 
-void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp__branch *out)
+void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
+                          lp__branch *out)
 {
     lp_vec3 r = reflect_dir(node);
     lp_vec3 pr = v3_cross(r, node->s);
-    double complex es, ep;
-    int real = project(node, E, &es, &ep);
+    double complex es = amp->es, ep = amp->ep;
+    int real = amp->real;
 
     out->dir = r;
     out->flip = 0;
@@ -116,14 +116,14 @@ void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp
     }
 }
 
-void lp__node_transmit(const lp__node *node, lp_mode mode, const lp__cvec3 *E,
-                       lp__branch *out)
+void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
+                           lp__branch *out)
 {
     double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
     lp_vec3 t = v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
     lp_vec3 pt = v3_cross(t, node->s);
-    double complex es, ep;
-    int real = project(node, E, &es, &ep);
+    double complex es = amp->es, ep = amp->ep;
+    int real = amp->real;
 
     out->dir = t;
     out->flip = 0;
@@ -134,4 +134,19 @@ void lp__node_transmit(const lp__node *node, lp_mode mode, const lp__cvec3 *E,
         double k = sqrt(T > 0.0 ? T : 0.0);
         out->E = combine(real, k * es, node->s, k * ep, pt);
     }
+}
+
+void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp__branch *out)
+{
+    lp__amp amp;
+    lp__node_project(node, E, &amp);
+    lp__node_reflect_amp(node, mode, &amp, out);
+}
+
+void lp__node_transmit(const lp__node *node, lp_mode mode, const lp__cvec3 *E,
+                       lp__branch *out)
+{
+    lp__amp amp;
+    lp__node_project(node, E, &amp);
+    lp__node_transmit_amp(node, mode, &amp, out);
 }

@@ -59,6 +59,22 @@ void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp
 void lp__node_transmit(const lp__node *node, lp_mode mode, const lp__cvec3 *E,
                        lp__branch *out);
 
+/* A field on the node's s and p axes of the incident wave.  Both
+ * branches of a node start from it, so a field is projected once. */
+typedef struct lp__amp {
+    double complex es, ep;
+    int real;         /* 1: both are real (the field had no imaginary part) */
+} lp__amp;
+
+void lp__node_project(const lp__node *node, const lp__cvec3 *E, lp__amp *out);
+
+/* The branches of G for a field already projected (lp__node_project);
+ * the same as lp__node_reflect / lp__node_transmit on that field. */
+void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
+                          lp__branch *out);
+void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
+                           lp__branch *out);
+
 /* Power reflectance of the node in an unpolarized mode (fresnel or
  * schlick); 1 under TIR. */
 double lp__node_reflectance(const lp__node *node, lp_mode mode);

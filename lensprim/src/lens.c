@@ -3,7 +3,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cap.h"
 #include "error.h"
+#include "glass_internal.h"
 #include "lens_internal.h"
 #include "vec3.h"
 
@@ -155,6 +157,8 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
     lens->v = v3_cross(lens->w, lens->u);
     if (desc->uniaxial)
         lens->crystal_axis = lp__to_local_dir(lens, lens->desc.crystal.axis);
+    lp__glass_ln_tau(desc->uniaxial ? &lens->desc.crystal.ordinary : &lens->desc.glass,
+                     lens->ln_tau);
     {
         double hz = 0.5 * (lens->z_max - lens->z_min);
         double r = sqrt(lens->h_max * lens->h_max + hz * hz) * (1.0 + 1e-9) + 4.0 * lens->eps;

@@ -39,6 +39,9 @@ struct lp_lens {
     lp_vec3 crystal_axis; /* a crystal's optic axis, local, unit */
     lp_vec3 bound_center; /* world centre of a sphere holding the lens */
     double bound_r2;      /* its squared radius, with a margin */
+    double ln_tau[LP_GLASS_TABLE_MAX]; /* log of the transmittance table of
+                                          the glass traced (a crystal's
+                                          ordinary one) */
 };
 
 /* A hit in the local frame. */
@@ -52,14 +55,15 @@ typedef struct lp__local_hit {
 /* Sag of a cap of curvature c at radius r: c r^2 / (1 + sqrt(1 - c^2 r^2)). */
 double lp__cap_sag(double c, double r);
 
-/* Smallest t in (t_min, t_max) where p + t d meets the cap patch.  When
- * on_surface is set, p lies on this cap and the root t = 0 is removed
- * exactly (the remaining root is -2b/c), so a ray never re-hits the point
- * it leaves.  Returns 1 on a hit. */
-int lp__cap_intersect(const lp__cap *cap, lp_vec3 p, lp_vec3 d, int on_surface,
-                      double t_min, double t_max, double *t);
-/* Outward unit normal at a point of the cap (exactly unit on the surface). */
-lp_vec3 lp__cap_normal(const lp__cap *cap, lp_vec3 p);
+/* Outward unit normal at a point of the cap (exactly unit on the surface;
+ * inline: every node needs one). */
+static inline lp_vec3 lp__cap_normal(const lp__cap *cap, lp_vec3 p)
+{
+    double c = cap->c;
+    lp_vec3 n = v3(c * p.x, c * p.y, c * (p.z - cap->z0) - 1.0);
+    /* |n| = 1 on the surface; renormalize only to remove rounding */
+    return v3_scale(v3_normalize(n), cap->out);
+}
 
 int lp__rim_intersect(const lp__rim *rim, lp_vec3 p, lp_vec3 d, double t_min,
                       double t_max, double *t);

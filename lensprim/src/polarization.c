@@ -8,23 +8,9 @@
 
 #include "polarization.h"
 
-static lp_vec3 unit_perp(lp_vec3 v, lp_vec3 dir)
+int lp__field_split_elliptic(const lp__cvec3 *E, double total, lp_vec3 dir,
+                             lp__linear_part part[2])
 {
-    return v3_normalize(v3_sub(v, v3_scale(dir, v3_dot(v, dir))));
-}
-
-int lp__field_split(const lp__cvec3 *E, lp_vec3 dir, lp__linear_part part[2])
-{
-    double total = cv3_norm2(*E);
-    if (!(total > 0.0))
-        return 0;
-    if (cv3_is_real(*E)) { /* linear already: psi = 0, A = E, B = 0 */
-        part[0].intensity = total;
-        part[0].vp = unit_perp(cv3_re(*E), dir);
-        part[0].phase = 0.0;
-        return 1;
-    }
-
     double complex q = E->x * E->x + E->y * E->y + E->z * E->z;
     double psi = (cimag(q) == 0.0 && creal(q) >= 0.0) ? 0.0 : 0.5 * carg(q);
     lp__cvec3 F = psi == 0.0 ? *E : cv3_scale(*E, cexp(-I * psi));
@@ -33,15 +19,15 @@ int lp__field_split(const lp__cvec3 *E, lp_vec3 dir, lp__linear_part part[2])
 
     if (ib <= 1e-20 * total) {
         part[0].intensity = total;
-        part[0].vp = unit_perp(a, dir);
+        part[0].vp = lp__unit_perp(a, dir);
         part[0].phase = psi;
         return 1;
     }
     part[0].intensity = ia;
-    part[0].vp = unit_perp(a, dir);
+    part[0].vp = lp__unit_perp(a, dir);
     part[0].phase = psi;
     part[1].intensity = ib;
-    part[1].vp = unit_perp(b, dir);
+    part[1].vp = lp__unit_perp(b, dir);
     part[1].phase = psi + 0.5 * LP_PI;
     return 2;
 }

@@ -10,12 +10,36 @@ typedef struct lp__linear_part {
     double phase;   /* radians */
 } lp__linear_part;
 
+/* The unit vector along the part of v perpendicular to the unit dir. */
+static inline lp_vec3 lp__unit_perp(lp_vec3 v, lp_vec3 dir)
+{
+    return v3_normalize(v3_sub(v, v3_scale(dir, v3_dot(v, dir))));
+}
+
+/* The split of a field with an imaginary part and power total > 0. */
+int lp__field_split_elliptic(const lp__cvec3 *E, double total, lp_vec3 dir,
+                             lp__linear_part part[2]);
+
 /* Write E (perpendicular to the unit dir) as the sum of at most two
  * linear waves sqrt(I_k) vp_k exp(i phase_k) along the axes of its
  * polarization ellipse: E = exp(i psi) (A + i B), A . B = 0, |A| >= |B|,
  * psi = arg(E . E)/2.  A linear field (B = 0 to 1e-10 relative amplitude)
  * gives one part carrying all the power.  A zero field gives 0 parts.
- * Returns the number of parts. */
-int lp__field_split(const lp__cvec3 *E, lp_vec3 dir, lp__linear_part part[2]);
+ * Returns the number of parts.  total is the field's power cv3_norm2(*E),
+ * which the caller has; inline, since a real field (every field before a
+ * total internal reflection) is one part at once. */
+static inline int lp__field_split(const lp__cvec3 *E, double total, lp_vec3 dir,
+                                  lp__linear_part part[2])
+{
+    if (!(total > 0.0))
+        return 0;
+    if (cv3_is_real(*E)) { /* linear already: psi = 0, A = E, B = 0 */
+        part[0].intensity = total;
+        part[0].vp = lp__unit_perp(cv3_re(*E), dir);
+        part[0].phase = 0.0;
+        return 1;
+    }
+    return lp__field_split_elliptic(E, total, dir, part);
+}
 
 #endif

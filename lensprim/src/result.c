@@ -28,15 +28,13 @@ void lp_result_release(lp_result *r)
     memset(r, 0, sizeof *r);
 }
 
-lp_out_ray *lp__result_push(lp_result *r)
+lp_out_ray *lp__result_grow(lp_result *r)
 {
-    if (r->count == r->capacity) {
-        size_t cap = r->capacity ? 2 * r->capacity : 16;
-        lp_out_ray *p = realloc(r->rays, cap * sizeof *p);
-        if (!p)
-            return NULL;
-        r->rays = p;
-        r->capacity = cap;
-    }
+    size_t cap = r->capacity ? 2 * r->capacity : 16;
+    lp_out_ray *p = realloc(r->rays, cap * sizeof *p);
+    if (!p)
+        return NULL;
+    r->rays = p;
+    r->capacity = cap;
     return &r->rays[r->count++];
 }

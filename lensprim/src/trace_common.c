@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include "error.h"
+#include "glass_internal.h"
 #include "polarization.h"
 #include "result.h"
 #include "trace.h"
@@ -20,7 +21,7 @@ lp_status lp__optics_at(const lp_lens *lens, double lambda_nm, lp__optics *o, lp
     o->lambda_nm = lambda_nm;
     o->n_glass = lp_glass_index(g, lambda_nm);
     o->n_medium = lp_glass_index(&d->medium, lambda_nm);
-    o->alpha = lp_glass_absorption(g, lambda_nm);
+    o->alpha = lp__glass_absorption_ln(g, lens->ln_tau, lambda_nm);
     if (!isfinite(o->n_glass) || !(o->n_glass > 0.0))
         return lp__fail(err, LP_ERROR_INVALID_GLASS, "glass %s has no valid index at %g nm",
                         g->name, lambda_nm);
@@ -100,12 +101,13 @@ double lp__wrap_phase(double x)
     return fabs(x) <= LP_PI ? x : remainder(x, 2.0 * LP_PI);
 }
 
-lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
-                   const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
-                   lp_error *err)
+/* lp__emit for a field of power cv3_norm2(*E) known already. */
+static lp_status emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
+                            double power, const lp__exit *x, const lp__payload *pl, int depth,
+                            lp_kind kind, int surface, uint64_t path, lp_error *err)
 {
     lp__linear_part part[2];
-    int n = lp__field_split(E, x->d, part);
+    int n = lp__field_split(E, power, x->d, part);
 
     for (int k = 0; k < n; k++) {
         lp_out_ray *o = lp__result_push(res);
@@ -131,6 +133,13 @@ lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, cons
     return LP_OK;
 }
 
+lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
+                   const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
+                   lp_error *err)
+{
+    return emit_power(lens, res, E, cv3_norm2(*E), x, pl, depth, kind, surface, path, err);
+}
+
 /* Send one outgoing field to the result, or count it as skipped. */
 lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
                     const lp__branch *b, lp_vec3 p, const lp__payload *pl, int depth,
@@ -150,7 +159,7 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
         res->skipped += power;
         return LP_OK;
     }
-    return lp__emit(lens, res, &b->E, &x, pl, depth, kind, surface, path, err);
+    return emit_power(lens, res, &b->E, power, &x, pl, depth, kind, surface, path, err);
 }
 
 lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,

@@ -42,18 +42,23 @@ lp_status lp__ray_failed(lp_error *err, lp_status st, size_t i)
     return st;
 }
 
+/* Trace one ray; *o holds the optics at the wavelength *o_valid says
+ * (NaN: none yet) and is recomputed only when the ray's differs. */
 static lp_status trace_one(const lp_lens *lens, const lp_ray *in, const lp_trace_args *a,
-                           lp_result *res, lp_error *err)
+                           lp__optics *o, double *o_valid, lp_result *res, lp_error *err)
 {
     lp_vec3 dw = {0, 0, 0}, vpw = dw;
-    lp__optics o;
     lp_status st;
 
     if ((st = lp__ray_check(in, &dw, &vpw, err)) != LP_OK)
         return st;
-    if ((st = lp__optics_at(lens, in->lambda_nm, &o, err)) != LP_OK)
-        return st;
-    return lp__trace_checked(lens, in, &o, lp__to_local_point(lens, in->origin),
+    if (!(in->lambda_nm == *o_valid)) {
+        *o_valid = NAN;
+        if ((st = lp__optics_at(lens, in->lambda_nm, o, err)) != LP_OK)
+            return st;
+        *o_valid = in->lambda_nm;
+    }
+    return lp__trace_checked(lens, in, o, lp__to_local_point(lens, in->origin),
                              lp__to_local_dir(lens, dw), lp__to_local_dir(lens, vpw), a, res,
                              err);
 }
@@ -89,7 +94,9 @@ lp_status lp__trace_checked(const lp_lens *lens, const lp_ray *in, const lp__opt
     /* Node 1: from the medium into the glass. */
     int tir = lp__node_setup(&node, d, h.n, o.n_medium, o.n_glass, &E);
     res->nodes++;
-    lp__node_reflect(&node, a->mode, &E, &refl);
+    lp__amp amp;
+    lp__node_project(&node, &E, &amp);
+    lp__node_reflect_amp(&node, a->mode, &amp, &refl);
     {
         lp__payload pr = pl;
         pr.kphi += refl.flip;
@@ -99,7 +106,7 @@ lp_status lp__trace_checked(const lp_lens *lens, const lp_ray *in, const lp__opt
     }
     if (tir)
         return LP_OK;
-    lp__node_transmit(&node, a->mode, &E, &trans);
+    lp__node_transmit_amp(&node, a->mode, &amp, &trans);
     E = trans.E;
     d = trans.dir;
     p = h.p;
@@ -135,14 +142,15 @@ lp_status lp__trace_checked(const lp_lens *lens, const lp_ray *in, const lp__opt
         depth++;
         tir = lp__node_setup(&node, d, h.n, o.n_glass, o.n_medium, &E);
         res->nodes++;
+        lp__node_project(&node, &E, &amp);
         if (!tir) {
-            lp__node_transmit(&node, a->mode, &E, &trans);
+            lp__node_transmit_amp(&node, a->mode, &amp, &trans);
             lp_kind kind = surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
             st = lp__leave(lens, a, res, &trans, p, &pl, depth, kind, surface, path, err);
             if (st != LP_OK)
                 return st;
         }
-        lp__node_reflect(&node, a->mode, &E, &refl);
+        lp__node_reflect_amp(&node, a->mode, &amp, &refl);
         E = refl.E;
         d = refl.dir;
         pl.kphi += refl.flip;
@@ -162,7 +170,9 @@ lp_status lp_trace_forward(const lp_lens *lens, const lp_ray *in, const lp_trace
     lp_result_clear(out);
     if ((st = lp__args_resolve(args, &a, err)) != LP_OK)
         return st;
-    if ((st = trace_one(lens, in, &a, out, err)) != LP_OK)
+    lp__optics o;
+    double o_valid = NAN;
+    if ((st = trace_one(lens, in, &a, &o, &o_valid, out, err)) != LP_OK)
         return st;
     lp__ok(err);
     return LP_OK;
@@ -180,9 +190,11 @@ lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in, size_t n,
     lp_result_clear(out);
     if ((st = lp__args_resolve(args, &a, err)) != LP_OK)
         return st;
+    lp__optics o; /* shared by consecutive rays of one wavelength */
+    double o_valid = NAN;
     for (size_t i = 0; i < n; i++) {
         offsets[i] = out->count;
-        if ((st = trace_one(lens, &in[i], &a, out, err)) != LP_OK)
+        if ((st = trace_one(lens, &in[i], &a, &o, &o_valid, out, err)) != LP_OK)
             return lp__ray_failed(err, st, i);
     }
     offsets[n] = out->count;
