@@ -63,20 +63,6 @@ double lp__node_reflectance(const lp__node *node, lp_mode mode)
     return 0.5 * (node->f.Rs + node->f.Rp);
 }
 
-void lp__node_project(const lp__node *node, const lp__cvec3 *E, lp__amp *out)
-{
-    if (cv3_is_real(*E)) {
-        lp_vec3 e = cv3_re(*E);
-        out->es = v3_dot(e, node->s);
-        out->ep = v3_dot(e, node->p);
-        out->real = 1;
-        return;
-    }
-    out->es = cv3_dot_real(*E, node->s);
-    out->ep = cv3_dot_real(*E, node->p);
-    out->real = 0;
-}
-
 /* a u + b w, in real arithmetic when a and b are real. */
 static lp__cvec3 combine(int real, double complex a, lp_vec3 u, double complex b, lp_vec3 w)
 {

@@ -60,13 +60,26 @@ void lp__node_transmit(const lp__node *node, lp_mode mode, const lp__cvec3 *E,
                        lp__branch *out);
 
 /* A field on the node's s and p axes of the incident wave.  Both
- * branches of a node start from it, so a field is projected once. */
+ * branches of a node start from it, so a field is projected once (inline:
+ * every node projects one). */
 typedef struct lp__amp {
     double complex es, ep;
     int real;         /* 1: both are real (the field had no imaginary part) */
 } lp__amp;
 
-void lp__node_project(const lp__node *node, const lp__cvec3 *E, lp__amp *out);
+static inline void lp__node_project(const lp__node *node, const lp__cvec3 *E, lp__amp *out)
+{
+    if (cv3_is_real(*E)) {
+        lp_vec3 e = cv3_re(*E);
+        out->es = v3_dot(e, node->s);
+        out->ep = v3_dot(e, node->p);
+        out->real = 1;
+        return;
+    }
+    out->es = cv3_dot_real(*E, node->s);
+    out->ep = cv3_dot_real(*E, node->p);
+    out->real = 0;
+}
 
 /* The branches of G for a field already projected (lp__node_project);
  * the same as lp__node_reflect / lp__node_transmit on that field. */
