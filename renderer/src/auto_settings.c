@@ -139,6 +139,7 @@ typedef struct probe_set {
     size_t n[N_GROUPS];     /* pixels in each group */
     double share[N_GROUPS]; /* the group's share of the image's pixels */
     double lens_share;      /* of the pixels whose camera ray meets a lens */
+    double pop[N_GROUPS];   /* the pixels each group's probe pixels stand for */
 } probe_set;
 
 /* Does the camera ray (o, d) meet a lens, through at most a few
@@ -302,6 +303,8 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
         ps->share[G_MARKED] = marked;
         for (int g = G_LENS; g < N_GROUPS; g++)
             ps->share[g] = rest > 0 ? (1.0 - marked) * (double)count[g] / (double)rest : 0.0;
+        for (int g = 0; g < N_GROUPS; g++)
+            ps->pop[g] = ps->share[g] * (double)total;
     }
     /* Every marked pixel; every k-th pixel of each other group, in scan
      * order. */
@@ -350,19 +353,30 @@ static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set 
                          out, samples, msg, msg_size);
 }
 
-/* RMS difference over the image, estimated from the probe. */
+/* RMS difference over the image, estimated from the probe: each group's
+ * mean square, plus one standard error of it where the group is a
+ * subsample (a few pixels that differ much more than the others are
+ * what a subsample most often under-counts). */
 static double rms_diff(const probe_set *ps, const rs_color *a, const rs_color *b)
 {
     double total = 0.0;
     size_t k = 0;
     for (int g = 0; g < N_GROUPS; g++) {
-        double s = 0.0;
+        double s = 0.0, s2 = 0.0, n = (double)ps->n[g];
         for (size_t m = 0; m < ps->n[g]; m++, k++) {
             double dr = a[k].r - b[k].r, dg = a[k].g - b[k].g, db = a[k].b - b[k].b;
-            s += dr * dr + dg * dg + db * db;
+            double x = (dr * dr + dg * dg + db * db) / 3.0;
+            s += x;
+            s2 += x * x;
         }
-        if (ps->n[g])
-            total += ps->share[g] * s / (3.0 * (double)ps->n[g]);
+        if (!ps->n[g])
+            continue;
+        double mean = s / n, se = 0.0;
+        if (ps->n[g] > 1 && ps->pop[g] > n) {
+            double var = fmax(0.0, (s2 - n * mean * mean) / (n - 1.0));
+            se = sqrt(var / n * (1.0 - n / ps->pop[g]));
+        }
+        total += ps->share[g] * (mean + se);
     }
     return sqrt(total);
 }
@@ -378,7 +392,7 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     int rc = -1, n_lenses, over = 0;
     double dn = dispersion_max(scene, &n_lenses);
     size_t n;
-    probe_set ps = {NULL, {0, 0, 0}, {0, 0, 0}, 0.0};
+    probe_set ps = {NULL, {0, 0, 0}, {0, 0, 0}, 0.0, {0, 0, 0}};
     rs_color *cur = NULL, *next = NULL, *tmp;
     rs_render_opts o;
 

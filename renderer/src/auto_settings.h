@@ -53,7 +53,10 @@
  * one in 4 of the other pixels whose camera ray meets a lens (through
  * polarizers, which are thin sheets) and one in 32 of the rest (at least
  * 24 and 8, at most 1024 of each, lens pixels at most one in 16 of the
- * image), each group weighted by its share of the image.  Its cost,
+ * image), each group weighted by its share of the image; a subsampled
+ * group's mean square is taken one standard error high (polariscope at
+ * 16 x 12, E = 1e-4: without it the probe under-counted the change 16 ->
+ * 32 wavelengths and auto stopped at 16, 1.0e-4 off).  Its cost,
  * wavelength samples summed over its renders (a pilot pixel in rgb counts
  * one), is returned; at 32 x 24 it is measured 0.38-0.56 of the chosen
  * render's where that is cheap, less at larger sizes.  Nothing here renders
