@@ -35,6 +35,8 @@
  * Physical constants (Planck's law): CODATA 2018 / SI 2019 exact values
  *   of h, c and k. */
 #include <math.h>
+#include <stdint.h>
+#include <string.h>
 
 #include "support/colorimetry.h"
 
@@ -756,6 +758,38 @@ double rs_srgb_encode(double v)
     if (v <= 0.0031308)
         return 12.92 * v;
     return 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+}
+
+unsigned char rs_srgb8_by_formula(float v)
+{
+    return (unsigned char)(rs_srgb_encode(v) * 255.0 + 0.5);
+}
+
+/* The least positive float (as its bits) whose code is >= k, k in 1..255:
+ * bisection over the bit patterns of (0, 1], where the code is
+ * non-decreasing (the order of the bits is the order of the values). */
+static float least_of_code(unsigned k)
+{
+    uint32_t lo = 0, hi = 0x3f800000u; /* code(lo) < k <= code(hi) = 255 */
+    while (hi - lo > 1) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        float f;
+        memcpy(&f, &mid, sizeof f);
+        if (rs_srgb8_by_formula(f) >= k)
+            hi = mid;
+        else
+            lo = mid;
+    }
+    float f;
+    memcpy(&f, &hi, sizeof f);
+    return f;
+}
+
+void rs_srgb8_table_init(rs_srgb8_table *t)
+{
+    t->at_least[0] = 0.0f;
+    for (unsigned k = 1; k < 256; k++)
+        t->at_least[k] = least_of_code(k);
 }
 
 double rs_srgb_decode(double v)

@@ -251,7 +251,10 @@ static int png_write_stream(FILE *f, const rs_image *img, int linear16,
     png_structp png;
     png_infop info;
     unsigned char *row;
+    rs_srgb8_table srgb8;
 
+    if (!linear16)
+        rs_srgb8_table_init(&srgb8);
     row = malloc(row_bytes);
     if (!row) {
         set_msg(msg, msg_size, "out of memory");
@@ -283,6 +286,11 @@ static int png_write_stream(FILE *f, const rs_image *img, int linear16,
         /* sRGB + gAMA 45455 + cHRM (the sRGB values). */
         png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
     }
+    /* The "up" filter alone: on four shipped scenes' renders (default,
+     * newtons_rings, desk_lamp, machined_parts) it wrote files within -1 ..
+     * +6 % of the size of libpng's adaptive choice among all five filters,
+     * in 54-68 % of the PNG stage's instructions. */
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
     png_write_info(png, info);
     for (int y = 0; y < h; y++) {
         const float *src = img->rgb + (size_t)y * w * 3;
@@ -298,7 +306,7 @@ static int png_write_stream(FILE *f, const rs_image *img, int linear16,
                 row[2 * i] = (unsigned char)(q >> 8);
                 row[2 * i + 1] = (unsigned char)(q & 0xff);
             } else {
-                row[i] = (unsigned char)(rs_srgb_encode(src[i]) * 255.0 + 0.5);
+                row[i] = rs_srgb8(&srgb8, src[i]);
             }
         }
         png_write_row(png, row);

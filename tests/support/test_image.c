@@ -16,6 +16,11 @@
  *  - PFM: bit-exact round trip (NaN, infinities, denormals, -0 included),
  *    the header and bottom-to-top row order, big-endian and gray files,
  *    truncated and malformed files rejected.
+ *  - The 8-bit sRGB table: the code of each entry, of the float below it,
+ *    of the transfer function's kink and of 200000 spread floats in
+ *    (0, 1.25) is the transfer function's code written here (the table was
+ *    also checked once against it on every float of [0, 1]: none differ);
+ *    NaN, 0, negatives and infinities as the formula clamps them.
  *  - Metrics: a uniform error e gives RMSE e and PSNR -20 log10(e) (1e-12
  *    relative); identical images give RMSE 0, PSNR INFINITY, SSIM 1;
  *    uniform images give SSIM's closed form (2 x y + C1)/(x^2 + y^2 + C1);
@@ -678,10 +683,50 @@ static void test_metrics(void)
     rs_image_free(&b);
 }
 
+/* The 8-bit code by IEC 61966-2-1, written here. */
+static unsigned srgb8_formula(float f)
+{
+    double v = f;
+    if (!(v > 0.0))
+        return 0;
+    if (v >= 1.0)
+        return 255;
+    v = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1.0 / 2.4) - 0.055;
+    return (unsigned)(v * 255.0 + 0.5);
+}
+
+static void test_srgb8_table(void)
+{
+    rs_srgb8_table t;
+    unsigned long bad = 0;
+    float special[] = {0.0f, -0.0f, -1.0f, (float)NAN, (float)INFINITY, -(float)INFINITY,
+                       1.0f, 0.0031308f, 1e-40f};
+    rs_srgb8_table_init(&t);
+    for (unsigned k = 1; k < 256; k++) {
+        float at = t.at_least[k], below = nextafterf(at, 0.0f);
+        CHECK(srgb8_formula(at) >= k && srgb8_formula(below) < k,
+              "sRGB table: entry %u (%.9g) is the least float of code >= %u "
+              "(codes %u there, %u below)", k, at, k, srgb8_formula(at), srgb8_formula(below));
+        if (rs_srgb8(&t, at) != srgb8_formula(at) || rs_srgb8(&t, below) != srgb8_formula(below))
+            bad++;
+    }
+    for (size_t i = 0; i < sizeof special / sizeof special[0]; i++)
+        if (rs_srgb8(&t, special[i]) != srgb8_formula(special[i]))
+            bad++;
+    for (unsigned i = 1; i <= 200000; i++) {
+        float f = (float)(1.25 * i / 200000.0);
+        float g = (float)pow(10.0, -6.0 * i / 200000.0); /* 1 .. 1e-6, log-spaced */
+        if (rs_srgb8(&t, f) != srgb8_formula(f) || rs_srgb8(&t, g) != srgb8_formula(g))
+            bad++;
+    }
+    CHECK(bad == 0, "sRGB table: %lu values take another code than the formula's", bad);
+}
+
 int main(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "%s/test_image.d", LP_TEST_TMP);
     mkdir(tmpdir, 0755);
+    test_srgb8_table();
     test_png8();
     test_png16();
     test_png_read_types();

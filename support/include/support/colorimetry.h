@@ -116,4 +116,32 @@ double rs_srgb_encode(double linear);
  * input clamped to [0, 1], NaN -> 0. */
 double rs_srgb_decode(double encoded);
 
+/* The 8-bit sRGB code of a linear value, (int)(rs_srgb_encode(v) * 255 +
+ * 0.5), without a power per value: the table holds, for each code k in
+ * 1..255, the least float that takes code k or more; a value's code is the
+ * number of entries at or below it (found in 8 comparisons).  It gives the
+ * formula's byte for every float (the formula is non-decreasing in v; the
+ * test checks each entry and its neighbours). */
+typedef struct rs_srgb8_table {
+    float at_least[256]; /* [k]: least float of code >= k; [0] unused */
+} rs_srgb8_table;
+
+/* Fills t (once per image, ~2000 power evaluations). */
+void rs_srgb8_table_init(rs_srgb8_table *t);
+
+/* The code of v by the formula (NaN and v <= 0: 0; v >= 1: 255). */
+unsigned char rs_srgb8_by_formula(float v);
+
+/* The same code from the table. */
+static inline unsigned char rs_srgb8(const rs_srgb8_table *t, float v)
+{
+    unsigned k = 0;
+    if (!(v > 0.0f))
+        return 0;
+    for (unsigned step = 128; step > 0; step >>= 1)
+        if (k + step <= 255 && t->at_least[k + step] <= v)
+            k += step;
+    return (unsigned char)k;
+}
+
 #endif
