@@ -1,0 +1,71 @@
+#!/bin/sh
+# Are two builds' renders the same?  Renders every shipped scene
+# (scenes/*.scene and scenes/*/*.scene) in every light model, with and
+# without --no-dispersion, with lensrender from OLD_BIN and from NEW_BIN,
+# and compares the float renders (--pfm): a file equal byte for byte is
+# "identical"; otherwise the largest absolute difference of a sample is
+# printed.  For a speed change that must not change results.
+#   sh scripts/same_renders.sh OLD_BIN NEW_BIN [WIDTH HEIGHT]
+# OLD_BIN and NEW_BIN are directories holding lensrender (e.g. a build of
+# the commit before, and build/bin).  Exit status 0 when every render is
+# identical, 1 when one differs, 2 on bad arguments or a failed render.
+set -eu
+if [ $# -ne 2 ] && [ $# -ne 4 ]; then
+    echo "usage: sh scripts/same_renders.sh OLD_BIN NEW_BIN [WIDTH HEIGHT]" >&2
+    exit 2
+fi
+old=$1
+new=$2
+W=${3:-64}
+H=${4:-48}
+for b in "$old" "$new"; do
+    [ -x "$b/lensrender" ] || { echo "same_renders: no lensrender in $b" >&2; exit 2; }
+done
+cd "$(dirname "$0")/.."
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+
+# The largest |a - b| over the float samples of two PFM files of one size
+# (the three header lines skipped; od prints the samples as floats).
+largest_difference() {
+    head_bytes=$(head -n 3 "$1" | wc -c)
+    tail -c +"$((head_bytes + 1))" "$1" | od -An -v -f >"$tmp/a.txt"
+    tail -c +"$((head_bytes + 1))" "$2" | od -An -v -f >"$tmp/b.txt"
+    tr -s ' ' '\n' <"$tmp/a.txt" | sed '/^$/d' >"$tmp/a1.txt"
+    tr -s ' ' '\n' <"$tmp/b.txt" | sed '/^$/d' >"$tmp/b1.txt"
+    paste "$tmp/a1.txt" "$tmp/b1.txt" | awk '
+        $1 == $2 { next }
+        $1 ~ /n/ || $2 ~ /n/ { odd = 1; next } # nan or inf on one side
+        { d = $1 - $2; if (d < 0) d = -d; if (d > m) m = d }
+        END { printf "%.3g%s", m, odd ? " (and non-finite samples that differ)" : "" }'
+}
+
+same=0
+differ=0
+for s in scenes/*.scene scenes/*/*.scene; do
+    [ -f "$s" ] || continue
+    n=$(basename "$s" .scene)
+    for m in polarized fresnel schlick rgb; do
+        for d in "" --no-dispersion; do
+            for side in old new; do
+                eval "bin=\$$side"
+                # shellcheck disable=SC2086 # $d is empty or one word
+                if ! "$bin/lensrender" "$s" --width "$W" --height "$H" --mode "$m" $d \
+                        --quiet -o "$tmp/$side.png" --pfm "$tmp/$side.pfm" 2>"$tmp/err"; then
+                    echo "same_renders: $bin/lensrender $s --mode $m $d failed:" >&2
+                    cat "$tmp/err" >&2
+                    exit 2
+                fi
+            done
+            if cmp -s "$tmp/old.pfm" "$tmp/new.pfm"; then
+                same=$((same + 1))
+            else
+                differ=$((differ + 1))
+                printf '%s %s %s: largest difference %s\n' "$n" "$m" "${d:-dispersion}" \
+                    "$(largest_difference "$tmp/old.pfm" "$tmp/new.pfm")"
+            fi
+        done
+    done
+done
+printf '%d renders identical, %d differ (%dx%d)\n' "$same" "$differ" "$W" "$H"
+[ "$differ" -eq 0 ]
