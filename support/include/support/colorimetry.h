@@ -126,7 +126,8 @@ typedef struct rs_srgb8_table {
     float at_least[256]; /* [k]: least float of code >= k; [0] unused */
 } rs_srgb8_table;
 
-/* Fills t (once per image, ~2000 power evaluations). */
+/* Fills t (once per image: 255 bisections of 30 steps, ~7700 power
+ * evaluations, about 0.26 ms). */
 void rs_srgb8_table_init(rs_srgb8_table *t);
 
 /* The code of v by the formula (NaN and v <= 0: 0; v >= 1: 255). */
