@@ -55,6 +55,11 @@ lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, cons
                    const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
                    lp_error *err);
 
+/* lp__emit for a field whose power cv3_norm2(*E) is known already. */
+lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, double power,
+                         const lp__exit *x, const lp__payload *pl, int depth, lp_kind kind,
+                         int surface, uint64_t path, lp_error *err);
+
 /* x wrapped into [-pi, pi] (x itself when it lies there already). */
 double lp__wrap_phase(double x);
 

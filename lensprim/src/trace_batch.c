@@ -13,8 +13,9 @@
 
 #include "error.h"
 #include "trace.h"
+#include "trace_lanes.h"
 
-#define BLOCK 64
+#define BLOCK LP__LANES
 
 /* A block of rays, checked and in the lens frame. */
 typedef struct block {
@@ -23,6 +24,7 @@ typedef struct block {
     double vx[BLOCK], vy[BLOCK], vz[BLOCK]; /* local unit field direction */
     double ok_vp[BLOCK];                    /* 1: the field direction is good */
     double bb[BLOCK], cc[BLOCK];            /* the bounding-sphere test */
+    unsigned char take[BLOCK];              /* for the lane engine */
 } block;
 
 /* Rays i0 .. i0+m of in into b: the one loop meant to be vectorized. */
@@ -81,23 +83,36 @@ static lp_ray ray_at(const lp_ray_soa *in, size_t i, double lambda_nm)
     return r;
 }
 
-/* One ray of a block: checked by the block's numbers, or (a ray the
- * block's check refused) by the one-ray check, which words the error. */
-static lp_status trace_lane(const lp_lens *lens, const lp__optics *o, const lp_ray *r,
-                            const block *b, size_t j, const lp_trace_args *a, lp_result *out,
-                            lp_error *err)
+/* Is ray r (lane j of b) valid by the block's numbers, and does it reach
+ * the lens's bounding sphere?  -1: the block's check refused it (the
+ * one-ray check words the error); 0: it misses the lens; 1: it is in. */
+static int lane_class(const lp_ray *r, const block *b, size_t j)
 {
     int good = v3_finite(r->origin) && v3_finite(r->dir) && b->ok_vp[j] != 0.0 &&
                (r->dir.x != 0.0 || r->dir.y != 0.0 || r->dir.z != 0.0) &&
                isfinite(r->intensity) && r->intensity >= 0.0 && isfinite(r->op) &&
                isfinite(r->phase) && v3_finite(r->vp);
-    if (good) {
-        if (b->cc[j] > 0.0 && (b->bb[j] > 0.0 || b->bb[j] * b->bb[j] < b->cc[j]))
-            return LP_OK; /* misses the bounding sphere, so the lens */
+    if (!good)
+        return -1;
+    return !(b->cc[j] > 0.0 && (b->bb[j] > 0.0 || b->bb[j] * b->bb[j] < b->cc[j]));
+}
+
+/* One ray of a block: from the lane engine's run, or traced by the
+ * one-ray code from the block's numbers, or (a ray the block's check
+ * refused) by the one-ray check, which words the error. */
+static lp_status trace_lane(const lp_lens *lens, const lp__optics *o, const lp_ray *r,
+                            const block *b, const lp__lanes *L, size_t j,
+                            const lp_trace_args *a, lp_result *out, lp_error *err)
+{
+    if (L && lp__lanes_traced(L, j))
+        return lp__lanes_emit(L, j, lens, a, r, out, err);
+    int cls = lane_class(r, b, j);
+    if (cls == 0)
+        return LP_OK; /* misses the bounding sphere, so the lens */
+    if (cls > 0)
         return lp__trace_checked(lens, r, o, v3(b->px[j], b->py[j], b->pz[j]),
                                  v3(b->dx[j], b->dy[j], b->dz[j]),
                                  v3(b->vx[j], b->vy[j], b->vz[j]), a, out, err);
-    }
     lp_vec3 d, vp;
     lp_status st = lp__ray_check(r, &d, &vp, err);
     if (st != LP_OK)
@@ -126,17 +141,32 @@ lp_status lp_trace_forward_soa(const lp_lens *lens, double lambda_nm, const lp_r
         return st;
     if ((st = lp__optics_at(lens, lambda_nm, &o, err)) != LP_OK)
         return st;
+    /* the lane engine's scratch; without it every ray takes the one-ray
+     * code, with the same results */
+    lp__lanes *L = lp__lanes_create(a.max_depth);
     for (size_t i0 = 0; i0 < n; i0 += BLOCK) {
         size_t m = n - i0 < BLOCK ? n - i0 : BLOCK;
         load_block(lens, in, i0, m, &b);
+        if (L) {
+            for (size_t j = 0; j < m; j++) {
+                lp_ray r = ray_at(in, i0 + j, lambda_nm);
+                b.take[j] = lane_class(&r, &b, j) > 0;
+            }
+            lp__lane_in li = {b.px, b.py, b.pz, b.dx, b.dy, b.dz, b.vx, b.vy, b.vz,
+                              in->intensity + i0, in->op ? in->op + i0 : NULL, b.take};
+            lp__lanes_run(L, lens, &o, &a, &li, m);
+        }
         for (size_t j = 0; j < m; j++) {
             size_t i = i0 + j;
             lp_ray r = ray_at(in, i, lambda_nm);
             offsets[i] = out->count;
-            if ((st = trace_lane(lens, &o, &r, &b, j, &a, out, err)) != LP_OK)
+            if ((st = trace_lane(lens, &o, &r, &b, L, j, &a, out, err)) != LP_OK) {
+                lp__lanes_destroy(L);
                 return lp__ray_failed(err, st, i);
+            }
         }
     }
+    lp__lanes_destroy(L);
     offsets[n] = out->count;
     lp__ok(err);
     return LP_OK;
