@@ -113,6 +113,15 @@ lp_status lp__ray_check(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err
 /* Prefix the message in err with "ray i: " and return st (batch calls). */
 lp_status lp__ray_failed(lp_error *err, lp_status st, size_t i);
 
+/* Trace the records in[0..n) of one wavelength, whose optics are o, as
+ * lp_trace_forward_many does: offsets[base + i] = out->count before ray
+ * i, and an error names ray base + i.  *L is the lane engine's scratch
+ * (trace_lanes.h), made on first use; the caller destroys it. */
+struct lp__lanes;
+lp_status lp__trace_run(const lp_lens *lens, const lp__optics *o, const lp_trace_args *a,
+                        const lp_ray *in, size_t n, size_t base, lp_result *out, size_t *offsets,
+                        struct lp__lanes **L, lp_error *err);
+
 /* Trace a checked ray (lp__ray_check) at the optics o of its wavelength:
  * local origin p, local unit direction d, local unit field direction vp;
  * its intensity and payload from *in.  Adds to res (not cleared). */

@@ -29,14 +29,6 @@
 
 #define NL LP__LANES
 
-/* The helpers of the loops below must be inlined, or the loops cannot be
- * vectorized. */
-#if defined(__GNUC__)
-#define LANE static inline __attribute__((always_inline))
-#else
-#define LANE static inline
-#endif
-
 /* What became of a ray of the group. */
 enum { RAY_OFF, RAY_MISS, RAY_BACK, RAY_RIM, RAY_CHAIN };
 /* How a chain ended before a node. */
@@ -162,18 +154,18 @@ static void consts_of(consts *K, const lp_lens *lens, const lp__optics *o, const
 
 /* ---- the one-ray code's formulas, free of branches ---------------- */
 
-LANE lp_vec3 world_dir(const consts *K, lp_vec3 d)
+LP__INLINE lp_vec3 world_dir(const consts *K, lp_vec3 d)
 {
     return v3_add(v3_add(v3_scale(K->u, d.x), v3_scale(K->v, d.y)), v3_scale(K->w, d.z));
 }
 
-LANE lp_vec3 world_point(const consts *K, lp_vec3 p)
+LP__INLINE lp_vec3 world_point(const consts *K, lp_vec3 p)
 {
     return v3_add(K->pos, world_dir(K, p));
 }
 
 /* lp__cap_on_patch */
-LANE int on_patch(double c, double hh, lp_vec3 x)
+LP__INLINE int on_patch(double c, double hh, lp_vec3 x)
 {
     double r2 = x.x * x.x + x.y * x.y;
     return !(r2 > hh) & (c * x.z <= 1.0);
@@ -182,7 +174,7 @@ LANE int on_patch(double c, double hh, lp_vec3 x)
 /* lp__cap_intersect from a point off the cap, t in (t_min, +inf): 1 and
  * *t on a hit.  (Its t_max is applied by the caller: a root the one-ray
  * code refuses for t >= t_max is followed by larger ones only.) */
-LANE int cap_far(double c, double z0, double hh, lp_vec3 p, lp_vec3 d, double t_min,
+LP__INLINE int cap_far(double c, double z0, double hh, lp_vec3 p, lp_vec3 d, double t_min,
                           double *t)
 {
     lp_vec3 q0 = v3(p.x, p.y, p.z - z0);
@@ -207,7 +199,7 @@ LANE int cap_far(double c, double z0, double hh, lp_vec3 p, lp_vec3 d, double t_
 }
 
 /* lp__cap_intersect from a point on the cap (on_surface), t > t_min. */
-LANE int cap_self(double c, double z0, double hh, lp_vec3 p, lp_vec3 d, double t_min,
+LP__INLINE int cap_self(double c, double z0, double hh, lp_vec3 p, lp_vec3 d, double t_min,
                            double *t)
 {
     lp_vec3 q0 = v3(p.x, p.y, p.z - z0);
@@ -218,7 +210,7 @@ LANE int cap_self(double c, double z0, double hh, lp_vec3 p, lp_vec3 d, double t
 }
 
 /* lp__rim_intersect, t in (t_min, +inf) (t_max as for cap_far). */
-LANE int rim_hit(const consts *K, lp_vec3 p, lp_vec3 d, double t_min, double *t)
+LP__INLINE int rim_hit(const consts *K, lp_vec3 p, lp_vec3 d, double t_min, double *t)
 {
     const lp__rim *rim = &K->r;
     double rp = rim->rho_a + rim->k * (p.z - rim->z_a);
@@ -245,14 +237,14 @@ LANE int rim_hit(const consts *K, lp_vec3 p, lp_vec3 d, double t_min, double *t)
 }
 
 /* lens.c's inside_rim */
-LANE int inside_rim(const consts *K, lp_vec3 p)
+LP__INLINE int inside_rim(const consts *K, lp_vec3 p)
 {
     double rho = K->r.rho_a + K->r.k * (p.z - K->r.z_a);
     return (rho > 0.0) & (p.x * p.x + p.y * p.y < rho * rho * (1.0 - 1e-9));
 }
 
 /* lp__lens_surface_at(lens, p) != LP_SURFACE_NONE */
-LANE int on_lens(const consts *K, lp_vec3 p)
+LP__INLINE int on_lens(const consts *K, lp_vec3 p)
 {
     double tol = K->tol;
     double r2 = p.x * p.x + p.y * p.y;
@@ -267,7 +259,7 @@ LANE int on_lens(const consts *K, lp_vec3 p)
 }
 
 /* lp__cap_normal of cap s (0 or 1, a number) at p. */
-LANE lp_vec3 cap_normal(const consts *K, double s, lp_vec3 p)
+LP__INLINE lp_vec3 cap_normal(const consts *K, double s, lp_vec3 p)
 {
     int b = s == 1.0;
     double c = b ? K->c[1] : K->c[0], z0 = b ? K->z0[1] : K->z0[0];
@@ -294,7 +286,7 @@ typedef struct node_out {
     double flip;        /* 1: a phase jump on reflection */
 } node_out;
 
-LANE void node(int law, double n1, double n2, double eta, double r0, lp_vec3 d, lp_vec3 normal,
+LP__INLINE void node(int law, double n1, double n2, double eta, double r0, lp_vec3 d, lp_vec3 normal,
                lp_vec3 e, lp_vec3 f, node_out *o, int *odd)
 {
     double dn = v3_dot(d, normal);
@@ -372,20 +364,20 @@ LANE void node(int law, double n1, double n2, double eta, double r0, lp_vec3 d, 
 }
 
 /* cv3_norm2 of the field e + i f. */
-LANE double power_of(lp_vec3 e, lp_vec3 f)
+LP__INLINE double power_of(lp_vec3 e, lp_vec3 f)
 {
     return e.x * e.x + f.x * f.x + e.y * e.y + f.y * f.y + e.z * e.z + f.z * f.z;
 }
 
 /* cv3_norm2 of a real field (its zero imaginary parts add nothing). */
-LANE double power_real(lp_vec3 e)
+LP__INLINE double power_real(lp_vec3 e)
 {
     return e.x * e.x + e.y * e.y + e.z * e.z;
 }
 
 /* An outgoing real field (lp__leave, lp__exit_at, lp__field_split) into
  * slot j of the fields f[NF][...] of one node. */
-LANE void stage(const consts *K, double (*f)[NL], size_t j, lp_vec3 x, lp_vec3 dir,
+LP__INLINE void stage(const consts *K, double (*f)[NL], size_t j, lp_vec3 x, lp_vec3 dir,
                          lp_vec3 e)
 {
     lp_vec3 o = world_point(K, x), dw = world_dir(K, dir);
@@ -407,7 +399,7 @@ LANE void stage(const consts *K, double (*f)[NL], size_t j, lp_vec3 x, lp_vec3 d
 
 /* Node 1 of every ray taken: the entry hit (lp__lens_hit from outside
  * the lens), the external reflection, the refracted field. */
-LANE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__lane_in *in, size_t m,
+LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__lane_in *in, size_t m,
                      int law)
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
@@ -457,7 +449,7 @@ LANE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__lane_in 
 /* The first half of a step from a node: the weight cut, the next
  * hit (lp__lens_hit from the cap the lane is on) but for the rim of the
  * lanes that could meet it (rim[c] = 1: see rim_step). */
-LANE void hit_step(lp__lanes *restrict L, const consts *Kp)
+LP__INLINE void hit_step(lp__lanes *restrict L, const consts *Kp)
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
     size_t n = L->n_chain;
@@ -494,6 +486,23 @@ LANE void hit_step(lp__lanes *restrict L, const consts *Kp)
     }
 }
 
+/* The vector loops, each in one copy per law and vector width. */
+LP__WIDE static void entry_kernel(lp__lanes *restrict L, const consts *K, const lp__lane_in *in,
+                                  size_t m, int law)
+{
+    switch (law) {
+    case LAW_POLARIZED: entry_step(L, K, in, m, LAW_POLARIZED); break;
+    case LAW_FRESNEL: entry_step(L, K, in, m, LAW_FRESNEL); break;
+    case LAW_SCHLICK_CI: entry_step(L, K, in, m, LAW_SCHLICK_CI); break;
+    default: entry_step(L, K, in, m, LAW_SCHLICK_CT); break;
+    }
+}
+
+LP__WIDE static void hit_kernel(lp__lanes *restrict L, const consts *K)
+{
+    hit_step(L, K);
+}
+
 /* The rim test of the lanes near it, one by one (few lanes need it). */
 static void rim_step(lp__lanes *restrict L, const consts *K)
 {
@@ -520,7 +529,7 @@ static void rim_step(lp__lanes *restrict L, const consts *K)
  * the hit (absorption, optical path), the rim, the node there (a real
  * field that meets no odd node): its outgoing ray into f, the reflected
  * field on.  odd[c] = 1 marks the lanes whose node odd_step does. */
-LANE void node_step(lp__lanes *restrict L, const consts *Kp, int law, double (*restrict f)[NL])
+LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law, double (*restrict f)[NL])
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
     size_t n = L->n_chain;
@@ -595,6 +604,17 @@ LANE void node_step(lp__lanes *restrict L, const consts *Kp, int law, double (*r
         L->back[c] = L->back[c] + (leak ? 1.0 : 0.0);
         L->odd[c] = odd ? 1.0 : 0.0;
         L->live[c] = live ? 1.0 : 0.0;
+    }
+}
+
+LP__WIDE static void node_kernel(lp__lanes *restrict L, const consts *K, int law,
+                                 double (*restrict f)[NL])
+{
+    switch (law) {
+    case LAW_POLARIZED: node_step(L, K, LAW_POLARIZED, f); break;
+    case LAW_FRESNEL: node_step(L, K, LAW_FRESNEL, f); break;
+    case LAW_SCHLICK_CI: node_step(L, K, LAW_SCHLICK_CI, f); break;
+    default: node_step(L, K, LAW_SCHLICK_CT, f); break;
     }
 }
 
@@ -679,7 +699,7 @@ static void pack(lp__lanes *L, const lp__lane_in *in, size_t m)
         L->entry[n] = L->surf[j];
         L->kphi[n] = 0.0;
         L->cut[n] = L->cut[j];
-        L->op[n] = in->op ? in->op[j] : 0.0;
+        L->op[n] = in->op[j];
         L->live[n] = 1.0;
         L->back[n] = 0.0;
         n++;
@@ -687,24 +707,24 @@ static void pack(lp__lanes *L, const lp__lane_in *in, size_t m)
     L->n_chain = n;
 }
 
-LANE void run(lp__lanes *restrict L, const consts *K, const lp_lens *lens, const lp__optics *op,
-              const lp__lane_in *in, size_t m, int max_depth, lp_mode mode, int law_in,
-              int law_out)
+static void run(lp__lanes *restrict L, const consts *K, const lp_lens *lens,
+                const lp__optics *op, const lp__lane_in *in, size_t m, int max_depth,
+                lp_mode mode, int law_in, int law_out)
 {
-    entry_step(L, K, in, m, law_in);
+    entry_kernel(L, K, in, m, law_in);
     pack(L, in, m);
     int absorbs = L->absorbs;
     L->staged = 1;
     for (int depth = 1; depth < max_depth; depth++) {
         size_t n = L->n_chain, live = 0, odd = 0;
         double (*f)[NL] = (double (*)[NL])(L->node + (size_t)(depth + 1) * NF * NL);
-        hit_step(L, K);
+        hit_kernel(L, K);
         rim_step(L, K);
         for (size_t c = 0; c < n; c++)
             live += L->live[c] != 0.0;
         for (size_t c = 0; c < n; c++)
             L->em[c] = absorbs && L->live[c] != 0.0 ? expm1(L->em[c]) : 0.0;
-        node_step(L, K, law_out, f);
+        node_kernel(L, K, law_out, f);
         L->staged = depth + 1;
         if (live == 0)
             break;
@@ -730,7 +750,7 @@ void lp__lanes_run(lp__lanes *L, const lp_lens *lens, const lp__optics *o,
     /* a crystal, or no interface at all: the one-ray code */
     int engine = !lens->desc.uniaxial && o->n_glass != o->n_medium;
     for (size_t j = 0; j < m; j++)
-        L->take[j] = engine && in->take[j] ? 1.0 : 0.0;
+        L->take[j] = engine && in->take[j] != 0.0 ? 1.0 : 0.0;
     lp_mode mode = a->mode;
     int depth = a->max_depth;
     if (mode == LP_MODE_POLARIZED)
@@ -754,21 +774,19 @@ int lp__lanes_traced(const lp__lanes *L, size_t j)
 /* One outgoing ray of a node (lp__leave): kept (and appended when it
  * carries power) or counted as skipped. */
 static lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
-                       const double (*f)[NL], size_t j, const lp_ray *in, double phase,
+                       const double (*f)[NL], size_t j, const lp__payload *pl, double phase,
                        int depth, int kphi, double op, lp_kind kind, int surface, uint64_t path,
                        lp_error *err)
 {
-    lp_branch_info info;
     double power = f[F_POW][j];
-    info.depth = depth;
-    info.kind = kind;
-    info.surface = surface;
-    info.origin = v3(f[F_OX][j], f[F_OY][j], f[F_OZ][j]);
-    info.dir = v3(f[F_DX][j], f[F_DY][j], f[F_DZ][j]);
-    info.bound = power;
-    if (!lp__args_keep(a, &info)) {
-        res->skipped += power;
-        return LP_OK;
+    lp_vec3 origin = v3(f[F_OX][j], f[F_OY][j], f[F_OZ][j]);
+    lp_vec3 dir = v3(f[F_DX][j], f[F_DY][j], f[F_DZ][j]);
+    if (a->filter || (kind == LP_KIND_REFLECT && a->flags)) {
+        lp_branch_info info = {depth, kind, surface, origin, dir, power};
+        if (!lp__args_keep(a, &info)) {
+            res->skipped += power;
+            return LP_OK;
+        }
     }
     if (f[F_EMIT][j] == EMIT_FIELD) {
         lp__cvec3 E;
@@ -776,24 +794,24 @@ static lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *r
         e[0] = f[F_ERX][j], e[1] = f[F_EIX][j];
         e[2] = f[F_ERY][j], e[3] = f[F_EIY][j];
         e[4] = f[F_ERZ][j], e[5] = f[F_EIZ][j];
-        lp__exit x = {v3(f[F_LX][j], f[F_LY][j], f[F_LZ][j]), info.origin, info.dir};
-        lp__payload pl = {in->lambda_nm, kphi, op, in->phase, in->ch};
-        return lp__emit_power(lens, res, &E, power, &x, &pl, depth, kind, surface, path, err);
+        lp__exit x = {v3(f[F_LX][j], f[F_LY][j], f[F_LZ][j]), origin, dir};
+        lp__payload p = {pl->lambda_nm, kphi, op, pl->phase, pl->ch};
+        return lp__emit_power(lens, res, &E, power, &x, &p, depth, kind, surface, path, err);
     }
     if (!(power > 0.0))
         return LP_OK;
     lp_out_ray *o = lp__result_push(res);
     if (!o)
         return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
-    o->ray.origin = info.origin;
-    o->ray.dir = info.dir;
-    o->ray.lambda_nm = in->lambda_nm;
+    o->ray.origin = origin;
+    o->ray.dir = dir;
+    o->ray.lambda_nm = pl->lambda_nm;
     o->ray.intensity = power;
     o->ray.vp = v3(f[F_VX][j], f[F_VY][j], f[F_VZ][j]);
     o->ray.kphi = kphi;
     o->ray.op = op;
     o->ray.phase = phase;
-    o->ray.ch = in->ch;
+    o->ray.ch = pl->ch;
     o->depth = depth;
     o->kind = kind;
     o->surface = surface;
@@ -805,23 +823,23 @@ static lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *r
 }
 
 lp_status lp__lanes_emit(const lp__lanes *L, size_t j, const lp_lens *lens,
-                         const lp_trace_args *a, const lp_ray *in, lp_result *res,
-                         lp_error *err)
+                         const lp_trace_args *a, double intensity, const lp__payload *pl,
+                         lp_result *res, lp_error *err)
 {
     lp_status st;
     if (L->ray[j] == RAY_MISS)
         return LP_OK;
-    res->in += in->intensity;
+    res->in += intensity;
     res->warnings |= L->warnings;
     if (L->ray[j] == RAY_RIM) {
-        res->absorbed_rim += in->intensity;
+        res->absorbed_rim += intensity;
         return LP_OK;
     }
     size_t c = L->lane[j];
     int entry = (int)L->entry[c];
-    double phase = lp__wrap_phase(in->phase + 0.0);
-    st = leave(lens, a, res, (const double (*)[NL])L->r1, j, in, phase, 1,
-               in->kphi + (int)L->r1[F_KPHI][j], in->op, LP_KIND_REFLECT, entry, 1u, err);
+    double phase = lp__wrap_phase(pl->phase + 0.0);
+    st = leave(lens, a, res, (const double (*)[NL])L->r1, j, pl, phase, 1,
+               pl->kphi + (int)L->r1[F_KPHI][j], pl->op, LP_KIND_REFLECT, entry, 1u, err);
     if (st != LP_OK)
         return st;
     uint64_t path = 0;
@@ -840,7 +858,7 @@ lp_status lp__lanes_emit(const lp__lanes *L, size_t j, const lp_lens *lens,
         }
         if (f[F_EMIT][c] != EMIT_NONE) {
             int surface = (int)f[F_SURF][c];
-            st = leave(lens, a, res, f, c, in, phase, k, in->kphi + (int)f[F_KPHI][c],
+            st = leave(lens, a, res, f, c, pl, phase, k, pl->kphi + (int)f[F_KPHI][c],
                        f[F_OP][c], surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
                        surface, path, err);
             if (st != LP_OK)

@@ -17,6 +17,27 @@
 
 #include "trace.h"
 
+/* The helpers of the loops over lanes must be inlined, or the loops
+ * cannot be vectorized. */
+#if defined(__GNUC__)
+#define LP__INLINE static inline __attribute__((always_inline))
+#else
+#define LP__INLINE static inline
+#endif
+
+/* The loops over lanes are compiled for the widest vectors of the
+ * machine that runs them (AVX-512, AVX2, else the baseline), chosen once
+ * when the program loads.  Every copy does the same operations in the
+ * same order (the build keeps FP contraction off), so all give the same
+ * bits. */
+#ifndef LP__WIDE /* a build may pin one copy (-DLP__WIDE=) to check it */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define LP__WIDE __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define LP__WIDE
+#endif
+#endif
+
 /* Rays per group. */
 #define LP__LANES 64
 
@@ -26,8 +47,8 @@ typedef struct lp__lane_in {
     const double *dx, *dy, *dz; /* unit directions */
     const double *vx, *vy, *vz; /* unit field directions, perpendicular */
     const double *intensity;    /* finite, >= 0 */
-    const double *op;           /* optical paths so far; NULL: 0 */
-    const unsigned char *take;  /* nonzero: the engine may trace the ray */
+    const double *op;           /* optical paths so far */
+    const double *take;         /* 1: the engine may trace the ray, 0: not */
 } lp__lane_in;
 
 typedef struct lp__lanes lp__lanes;
@@ -49,11 +70,11 @@ void lp__lanes_run(lp__lanes *L, const lp_lens *lens, const lp__optics *o,
 int lp__lanes_traced(const lp__lanes *L, size_t j);
 
 /* Add ray j's outgoing rays and sums to res, exactly as lp__trace_checked
- * would from the ray *in (its payload) and the same args: the flags and
- * the filter are applied here, in the order of the one-ray code.
- * Returns LP_ERROR_NO_MEMORY or LP_OK. */
+ * would for the ray of that intensity and payload pl with the same args:
+ * the flags and the filter are applied here, in the order of the one-ray
+ * code.  Returns LP_ERROR_NO_MEMORY or LP_OK. */
 lp_status lp__lanes_emit(const lp__lanes *L, size_t j, const lp_lens *lens,
-                         const lp_trace_args *a, const lp_ray *in, lp_result *res,
-                         lp_error *err);
+                         const lp_trace_args *a, double intensity, const lp__payload *pl,
+                         lp_result *res, lp_error *err);
 
 #endif

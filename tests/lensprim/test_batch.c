@@ -30,6 +30,7 @@
  *            before it kept, as lp_trace_forward_many), NULL optional
  *            arrays standing for 0, and n = 0.
  */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -428,11 +429,10 @@ static void test_identity(void)
         }
         lp_lens_destroy(lens);
     }
-    printf("identity: %d cases (lens x mode x depth x args, groups of 1..%zu), %zu rays, every "
-           "ray, offset and sum identical; among them %zu along a lens's axis, %zu starting on "
-           "a lens, %zu second parts of elliptical fields\n",
-           n_identity_cases, (size_t)MAX_RAYS, n_identity_rays, n_normal, n_on_lens,
-           n_two_parts);
+    printf("identity: %d cases (lens x mode x depth x args; whole sets, groups of 1 to 200), "
+           "%zu rays, every ray, offset and sum identical; among them %zu along a lens's axis, "
+           "%zu starting on a lens; %zu second parts of elliptical fields out\n",
+           n_identity_cases, n_identity_rays, n_normal, n_on_lens, n_two_parts);
 }
 
 static void test_closed_form(void)
@@ -598,10 +598,124 @@ static void test_errors(void)
     lp_lens_destroy(lens);
 }
 
+/* lp_trace_forward_many on records whose wavelengths come in runs of 1 to
+ * 130 (the runs of 8 and more go through the lane engine, the others ray
+ * by ray): every outgoing ray and offset is lp_trace_forward's for that
+ * ray, bit for bit; `in` and `out` are the sums, in order, of the
+ * intensities of the rays that meet the lens and of the outgoing rays'
+ * intensities, bit for bit; the
+ * other sums differ from the sums of lp_trace_forward's per-ray sums only
+ * by the order of their terms (each of n terms >= 0: at most n roundings
+ * of DBL_EPSILON/2 of the total).  An invalid ray or wavelength inside a
+ * long run stops the call at that ray with the one-ray code's message. */
+static void test_runs(void)
+{
+    static rays r;
+    static lp_ray recs[MAX_RAYS];
+    static size_t off[MAX_RAYS + 1];
+    const size_t lengths[] = {1, 2, 8, 9, 70, 3, 64, 65, 7, 130, 1, 8};
+    const double lambdas[] = {450.0, 550.0, 650.0, 500.0};
+    const char *glass[] = {"N-BK7", "N-SF11"};
+    lp_error err, err1;
+    lp_result res, one;
+
+    lp_result_init(&res);
+    lp_result_init(&one);
+    for (int gi = 0; gi < 2; gi++) {
+        lp_lens_desc desc;
+        lp_lens *lens;
+        lp_lens_desc_init(&desc);
+        desc.radius1 = gi ? 10 : 50;
+        desc.radius2 = gi ? -10 : -50;
+        desc.thickness = gi ? 19 : 8;
+        desc.diameter = gi ? 19.9 : 25;
+        CHECK(lp_glass_builtin(glass[gi], &desc.glass, &err) == LP_OK, "%s", err.message);
+        CHECK(lp_lens_create(&desc, &lens, &err) == LP_OK, "%s", err.message);
+        make_lane_rays(&r, lens, vec(0, 0, 0), vec(1, 0, 0), vec(0, 1, 0), vec(0, 0, 1),
+                       0.5 * desc.diameter, desc.thickness);
+        size_t n = 0;
+        for (size_t k = 0; n < r.n; k++) {
+            size_t len = lengths[k % (sizeof lengths / sizeof lengths[0])];
+            for (size_t i = 0; i < len && n < r.n; i++, n++)
+                recs[n] = record_of(&r, n, lambdas[k % 4]);
+        }
+        for (int mode = 0; mode < 3; mode++) {
+            lp_trace_args a;
+            lp_trace_args_init(&a);
+            a.mode = (lp_mode)mode;
+            a.max_depth = 6;
+            CHECK(lp_trace_forward_many(lens, recs, n, &a, &res, off, &err) == LP_OK, "%s",
+                  err.message);
+            size_t differ = 0, nodes = 0;
+            double in = 0.0, out = 0.0, rest[4] = {0, 0, 0, 0}, want[4];
+            unsigned warnings = 0;
+            for (size_t i = 0; i < n; i++) {
+                if (lp_trace_forward(lens, &recs[i], &a, &one, NULL) != LP_OK ||
+                    off[i + 1] - off[i] != one.count) {
+                    differ++;
+                    continue;
+                }
+                in += one.in; /* the ray's intensity, or 0 when it misses */
+                for (size_t k = 0; k < one.count; k++) {
+                    differ += !same_ray(&res.rays[off[i] + k], &one.rays[k]);
+                    out += one.rays[k].ray.intensity;
+                }
+                rest[0] += one.skipped, rest[1] += one.absorbed_glass;
+                rest[2] += one.absorbed_rim, rest[3] += one.truncated;
+                nodes += one.nodes;
+                warnings |= one.warnings;
+            }
+            CHECK(differ == 0, "%s mode %d: %zu of %zu rays differ from lp_trace_forward",
+                  glass[gi], mode, differ, n);
+            CHECK(memcmp(&in, &res.in, sizeof in) == 0 && memcmp(&out, &res.out, sizeof out) == 0,
+                  "%s mode %d: in %.17g / %.17g, out %.17g / %.17g", glass[gi], mode, res.in,
+                  in, res.out, out);
+            CHECK(nodes == res.nodes && warnings == res.warnings, "%s mode %d: nodes, warnings",
+                  glass[gi], mode);
+            want[0] = res.skipped, want[1] = res.absorbed_glass;
+            want[2] = res.absorbed_rim, want[3] = res.truncated;
+            for (int k = 0; k < 4; k++)
+                CHECK(fabs(want[k] - rest[k]) <= (double)n * DBL_EPSILON * rest[k],
+                      "%s mode %d: sum %d %.17g / %.17g", glass[gi], mode, k, want[k], rest[k]);
+        }
+        /* an invalid ray, then a bad wavelength, inside a run of 70 */
+        for (int bad = 0; bad < 2; bad++) {
+            size_t k = 40 + (size_t)bad;
+            lp_ray keep = recs[k];
+            if (bad == 0)
+                recs[k].vp = recs[k].dir; /* parallel to the direction */
+            else
+                for (size_t i = k; i < k + 5; i++)
+                    recs[i].lambda_nm = NAN;
+            lp_status st = lp_trace_forward_many(lens, recs, n, NULL, &res, off, &err);
+            lp_status s1 = lp_trace_forward(lens, &recs[k], NULL, &one, &err1);
+            char want_msg[300];
+            snprintf(want_msg, sizeof want_msg, "ray %zu: %s", k, err1.message);
+            CHECK(st == s1 && st != LP_OK && strcmp(err.message, want_msg) == 0,
+                  "%s bad %d: '%s', want '%s'", glass[gi], bad, err.message, want_msg);
+            size_t count = 0;
+            for (size_t i = 0; i < k; i++)
+                if (lp_trace_forward(lens, &recs[i], NULL, &one, NULL) == LP_OK)
+                    count += one.count;
+            CHECK(res.count == count && off[k] == count, "%s bad %d: the rays before it kept",
+                  glass[gi], bad);
+            for (size_t i = k; i < k + 5; i++)
+                recs[i].lambda_nm = keep.lambda_nm;
+            recs[k] = keep;
+        }
+        lp_lens_destroy(lens);
+    }
+    lp_result_release(&res);
+    lp_result_release(&one);
+    printf("runs: lp_trace_forward_many on runs of 1 to 130 rays of one wavelength, every "
+           "ray as lp_trace_forward's\n");
+}
+
 int main(void)
 {
     test_identity();
     test_closed_form();
     test_errors();
+    test_runs();
     return check_finish("test_batch");
 }
