@@ -25,6 +25,7 @@
 #include "interface.h"
 #include "polarization.h"
 #include "result.h"
+#include "lanes.h"
 #include "trace_lanes.h"
 
 #define NL LP__LANES
@@ -104,182 +105,33 @@ void lp__lanes_destroy(lp__lanes *L)
 /* The lens and the optics as the loops read them (copies, so that no
  * store to the lanes can be taken to change them). */
 typedef struct consts {
-    double c[2], z0[2], hh[2], out[2]; /* caps; hh = h^2 (1 + 1e-12) */
-    lp__rim r;
-    double has_rim;                    /* 1: r.present (as a number: the
-                                          loops' flags are all doubles'
-                                          comparisons) */
-    double slack;                      /* the rim's end tolerance */
-    double eps, tol;                   /* lens->eps, lp__lens_surface_at's */
-    lp_vec3 pos, u, v, w;
-    double ng, nm, ha;                 /* indices, -alpha/2 */
-    double eta_in, eta_out;            /* n_medium/n_glass, n_glass/n_medium */
-    double r0_in, r0_out;              /* Schlick's R0 */
-    double cut_w;                      /* min_weight */
+    lp__lane_lens lens;
+    double ng, nm, ha;      /* indices, -alpha/2 */
+    double eta_in, eta_out; /* n_medium/n_glass, n_glass/n_medium */
+    double r0_in, r0_out;   /* Schlick's R0 */
+    double cut_w;           /* min_weight */
 } consts;
-
-static double schlick_r0(double n1, double n2)
-{
-    double r0 = (n1 - n2) / (n1 + n2);
-    return r0 * r0;
-}
 
 static void consts_of(consts *K, const lp_lens *lens, const lp__optics *o, const lp_trace_args *a)
 {
-    for (int s = 0; s < 2; s++) {
-        const lp__cap *cap = &lens->cap[s];
-        K->c[s] = cap->c;
-        K->z0[s] = cap->z0;
-        K->hh[s] = cap->h * cap->h * (1.0 + 1e-12);
-        K->out[s] = cap->out;
-    }
-    K->r = lens->rim;
-    K->has_rim = lens->rim.present ? 1.0 : 0.0;
-    K->slack = 1e-12 * (K->r.z_b - K->r.z_a + K->r.rho_a + K->r.rho_b);
-    K->eps = lens->eps;
-    K->tol = 8.0 * lens->eps;
-    K->pos = lens->desc.position;
-    K->u = lens->u;
-    K->v = lens->v;
-    K->w = lens->w;
+    lp__lane_lens_of(&K->lens, lens);
     K->ng = o->n_glass;
     K->nm = o->n_medium;
     K->ha = -0.5 * o->alpha;
     K->eta_in = o->n_medium / o->n_glass;
     K->eta_out = o->n_glass / o->n_medium;
-    K->r0_in = schlick_r0(o->n_medium, o->n_glass);
-    K->r0_out = schlick_r0(o->n_glass, o->n_medium);
+    K->r0_in = lp__lane_schlick_r0(o->n_medium, o->n_glass);
+    K->r0_out = lp__lane_schlick_r0(o->n_glass, o->n_medium);
     K->cut_w = a->min_weight;
 }
 
-/* ---- the one-ray code's formulas, free of branches ---------------- */
-
-LP__INLINE lp_vec3 world_dir(const consts *K, lp_vec3 d)
-{
-    return v3_add(v3_add(v3_scale(K->u, d.x), v3_scale(K->v, d.y)), v3_scale(K->w, d.z));
-}
-
-LP__INLINE lp_vec3 world_point(const consts *K, lp_vec3 p)
-{
-    return v3_add(K->pos, world_dir(K, p));
-}
-
-/* lp__cap_on_patch */
-LP__INLINE int on_patch(double c, double hh, lp_vec3 x)
-{
-    double r2 = x.x * x.x + x.y * x.y;
-    return !(r2 > hh) & (c * x.z <= 1.0);
-}
-
-/* lp__cap_intersect from a point off the cap, t in (t_min, +inf): 1 and
- * *t on a hit.  (Its t_max is applied by the caller: a root the one-ray
- * code refuses for t >= t_max is followed by larger ones only.) */
-LP__INLINE int cap_far(double c, double z0, double hh, lp_vec3 p, lp_vec3 d, double t_min,
-                          double *t)
-{
-    lp_vec3 q0 = v3(p.x, p.y, p.z - z0);
-    double s0 = -v3_dot(q0, d);
-    lp_vec3 q = v3_madd(q0, d, s0);
-    double b = c * v3_dot(q, d) - d.z;
-    double g = c * v3_dot(q, q) - 2.0 * q.z;
-    double disc = b * b - c * g;
-    double qq = -(b + copysign(sqrt(disc), b));
-    double ra = g / qq, rb = qq / c;
-    int va = qq != 0.0, vb = c != 0.0;
-    double lo = va ? (vb & (rb < ra) ? rb : ra) : rb;
-    double hi = rb < ra ? ra : rb;
-    double s1 = s0 + lo, s2 = s0 + hi;
-    int real = !(disc < 0.0);
-    int ok1 = real & (va | vb) & (s1 > t_min) & (s1 < INFINITY) &
-              on_patch(c, hh, v3_madd(q0, d, s1));
-    int ok2 = real & va & vb & (s2 > t_min) & (s2 < INFINITY) &
-              on_patch(c, hh, v3_madd(q0, d, s2));
-    *t = ok1 ? s1 : s2;
-    return ok1 | ok2;
-}
-
-/* lp__cap_intersect from a point on the cap (on_surface), t > t_min. */
-LP__INLINE int cap_self(double c, double z0, double hh, lp_vec3 p, lp_vec3 d, double t_min,
-                           double *t)
-{
-    lp_vec3 q0 = v3(p.x, p.y, p.z - z0);
-    double b = c * v3_dot(q0, d) - d.z;
-    double s = -2.0 * b / c;
-    *t = s;
-    return (c != 0.0) & (s > t_min) & (s < INFINITY) & on_patch(c, hh, v3_madd(q0, d, s));
-}
-
-/* lp__rim_intersect, t in (t_min, +inf) (t_max as for cap_far). */
-LP__INLINE int rim_hit(const consts *K, lp_vec3 p, lp_vec3 d, double t_min, double *t)
-{
-    const lp__rim *rim = &K->r;
-    double rp = rim->rho_a + rim->k * (p.z - rim->z_a);
-    double A = d.x * d.x + d.y * d.y - rim->k * rim->k * d.z * d.z;
-    double B = p.x * d.x + p.y * d.y - rim->k * rp * d.z;
-    double C = p.x * p.x + p.y * p.y - rp * rp;
-    int lin = fabs(A) <= 1e-300;
-    double rl = -C / (2.0 * B);
-    double disc = B * B - A * C;
-    double q = -(B + copysign(sqrt(disc), B));
-    double ra = C / q, rb = q / A;
-    int va = q != 0.0;
-    double lo = lin ? rl : (va & (rb < ra) ? rb : (va ? ra : rb));
-    double hi = rb < ra ? ra : rb;
-    int v1 = lin ? B != 0.0 : !(disc < 0.0);
-    int v2 = !lin & !(disc < 0.0) & va;
-    double z1 = p.z + lo * d.z, z2 = p.z + hi * d.z;
-    int ok1 = v1 & (lo > t_min) & (lo < INFINITY) & !(z1 < rim->z_a - K->slack) &
-              !(z1 > rim->z_b + K->slack) & !(rim->rho_a + rim->k * (z1 - rim->z_a) < 0.0);
-    int ok2 = v2 & (hi > t_min) & (hi < INFINITY) & !(z2 < rim->z_a - K->slack) &
-              !(z2 > rim->z_b + K->slack) & !(rim->rho_a + rim->k * (z2 - rim->z_a) < 0.0);
-    *t = ok1 ? lo : hi;
-    return ok1 | ok2;
-}
-
-/* lens.c's inside_rim */
-LP__INLINE int inside_rim(const consts *K, lp_vec3 p)
-{
-    double rho = K->r.rho_a + K->r.k * (p.z - K->r.z_a);
-    return (rho > 0.0) & (p.x * p.x + p.y * p.y < rho * rho * (1.0 - 1e-9));
-}
-
-/* lp__lens_surface_at(lens, p) != LP_SURFACE_NONE */
-LP__INLINE int on_lens(const consts *K, lp_vec3 p)
-{
-    double tol = K->tol;
-    double r2 = p.x * p.x + p.y * p.y;
-    double z0 = p.z - K->z0[0], z1 = p.z - K->z0[1];
-    double f0 = K->c[0] * (r2 + z0 * z0) - 2.0 * z0;
-    double f1 = K->c[1] * (r2 + z1 * z1) - 2.0 * z1;
-    double rho = K->r.rho_a + K->r.k * (p.z - K->r.z_a);
-    return ((fabs(f0) <= 2.0 * tol) & (r2 <= K->hh[0] + tol) & (K->c[0] * z0 <= 1.0)) |
-           ((fabs(f1) <= 2.0 * tol) & (r2 <= K->hh[1] + tol) & (K->c[1] * z1 <= 1.0)) |
-           ((K->has_rim != 0.0) & (fabs(sqrt(r2) - rho) <= tol) & (p.z >= K->r.z_a - tol) &
-            (p.z <= K->r.z_b + tol));
-}
-
-/* lp__cap_normal of cap s (0 or 1, a number) at p. */
-LP__INLINE lp_vec3 cap_normal(const consts *K, double s, lp_vec3 p)
-{
-    int b = s == 1.0;
-    double c = b ? K->c[1] : K->c[0], z0 = b ? K->z0[1] : K->z0[0];
-    double out = b ? K->out[1] : K->out[0];
-    lp_vec3 n = v3(c * p.x, c * p.y, c * (p.z - z0) - 1.0);
-    return v3_scale(v3_normalize(n), out);
-}
-
-/* The law of a node: the mode, and for Schlick's the cosine it takes
- * (lp__schlick: the refracted one when n1 > n2).  A constant of each
- * copy of the loops, so that each is free of branches. */
-enum { LAW_POLARIZED, LAW_FRESNEL, LAW_SCHLICK_CI, LAW_SCHLICK_CT };
-
-/* A node (lp__node_setup, lp__fresnel_eval, lp__node_project,
- * lp__node_transmit_amp, lp__node_reflect_amp) of the field e + i f from
- * index n1 into n2, eta = n1/n2.  A field with an imaginary part (after a
- * total internal reflection: only in polarized mode) takes the complex
- * arithmetic of the one-ray code, a real one its real arithmetic.  *odd
- * is set where the one-ray code branches otherwise: total internal
- * reflection, normal incidence. */
+/* A node of the field e + i f (lp__lane_node_at, then the field's part of
+ * lp__node_setup, lp__node_project, lp__node_transmit_amp and
+ * lp__node_reflect_amp) from index n1 into n2, eta = n1/n2.  A field
+ * with an imaginary part (after a total internal reflection: only in
+ * polarized mode) takes the complex arithmetic of the one-ray code, a
+ * real one its real arithmetic.  *odd is set where the one-ray code
+ * branches otherwise: total internal reflection, normal incidence. */
 typedef struct node_out {
     lp_vec3 t, Et, Eti; /* transmitted direction and field */
     lp_vec3 r, Er, Eri; /* reflected direction and field */
@@ -287,43 +139,31 @@ typedef struct node_out {
 } node_out;
 
 LP__INLINE void node(int law, double n1, double n2, double eta, double r0, lp_vec3 d, lp_vec3 normal,
-               lp_vec3 e, lp_vec3 f, node_out *o, int *odd)
+                     lp_vec3 e, lp_vec3 f, node_out *o, int *odd)
 {
-    double dn = v3_dot(d, normal);
-    double adn = fabs(dn);
-    lp_vec3 nn = dn > 0.0 ? v3_neg(normal) : normal;
-    double ci = adn < 1.0 ? adn : 1.0;
-    /* Fresnel (lp__fresnel_eval, n1 != n2, no TIR) */
-    double sin2_i = (1.0 - ci) * (1.0 + ci);
-    double cos2_t = 1.0 - eta * eta * sin2_i;
-    double ct = sqrt(cos2_t);
-    double a = n1 * ci, b = n2 * ct;
-    double c = n2 * ci, dd = n1 * ct;
-    double is = 1.0 / (a + b), ip = 1.0 / (c + dd);
-    double rs = (a - b) * is;
-    double rp = (c - dd) * ip;
+    lp__lane_node g;
+    lp__lane_node_at(n1, n2, eta, d, normal, &g);
     /* the s and p axes */
-    lp_vec3 s = v3_cross(d, nn);
+    lp_vec3 s = v3_cross(d, g.nn);
     double sl2 = v3_dot(s, s);
-    *odd = (cos2_t < 0.0) | !(sl2 > 1e-18);
+    *odd = g.tir | !(sl2 > 1e-18);
     s = v3_scale(s, 1.0 / sqrt(sl2));
     lp_vec3 p = v3_cross(d, s);
     /* the field on them: real parts, and imaginary ones (0 when real) */
     int cplx = (f.x != 0.0) | (f.y != 0.0) | (f.z != 0.0);
     double es = v3_dot(e, s), ep = v3_dot(e, p);
     double esi = cplx ? v3_dot(f, s) : 0.0, epi = cplx ? v3_dot(f, p) : 0.0;
-    /* the branches' directions */
-    o->t = v3_normalize(v3_madd(v3_scale(d, eta), nn, eta * ci - ct));
-    o->r = v3_normalize(v3_madd(d, nn, 2.0 * ci));
+    o->t = g.t;
+    o->r = g.r;
     lp_vec3 pt = v3_cross(o->t, s), pr = v3_cross(o->r, s);
     /* the amplitudes on s and p: transmitted (t), reflected (r) */
     double ts_, tp_, tsi, tpi, rs_, rp_, rsi, rpi;
-    if (law == LAW_POLARIZED) {
-        double g = 2.0 * sqrt(a * b);
-        double mirror = rs * (es * es + esi * esi) - rp * (ep * ep + epi * epi);
+    if (law == LP__LAW_POLARIZED) {
+        double g2 = 2.0 * sqrt(g.a * g.b);
+        double mirror = g.rs * (es * es + esi * esi) - g.rp * (ep * ep + epi * epi);
         int flip = mirror < 0.0;
-        double gs = g * is, gp = g * ip;
-        double ks = flip ? -rs : rs, kp = flip ? -rp : rp;
+        double gs = g2 * g.is, gp = g2 * g.ip;
+        double ks = flip ? -g.rs : g.rs, kp = flip ? -g.rp : g.rp;
         double ki = flip ? -0.0 : 0.0; /* the imaginary part of +-rs, +-rp */
         o->flip = flip ? 1.0 : 0.0;
         ts_ = gs * es;
@@ -336,15 +176,7 @@ LP__INLINE void node(int law, double n1, double n2, double eta, double r0, lp_ve
         rsi = ks * esi + ki * es;
         rpi = kp * epi + ki * ep;
     } else {
-        double R;
-        if (law == LAW_SCHLICK_CI || law == LAW_SCHLICK_CT) {
-            /* lp__schlick: c is cos_t when n1 > n2 (ct, no TIR here) */
-            double m = 1.0 - (law == LAW_SCHLICK_CT ? ct : ci);
-            double m2 = m * m;
-            R = r0 + (1.0 - r0) * m2 * m2 * m;
-        } else {
-            R = 0.5 * (rs * rs + rp * rp);
-        }
+        double R = lp__lane_reflectance(law, r0, &g);
         double T = 1.0 - R;
         double kt = sqrt(T > 0.0 ? T : 0.0), kr = sqrt(R);
         o->flip = 0.0;
@@ -380,8 +212,8 @@ LP__INLINE double power_real(lp_vec3 e)
 LP__INLINE void stage(const consts *K, double (*f)[NL], size_t j, lp_vec3 x, lp_vec3 dir,
                          lp_vec3 e)
 {
-    lp_vec3 o = world_point(K, x), dw = world_dir(K, dir);
-    lp_vec3 vp = world_dir(K, lp__unit_perp(e, dir));
+    lp_vec3 o = lp__lane_world_point(&K->lens, x), dw = lp__lane_world_dir(&K->lens, dir);
+    lp_vec3 vp = lp__lane_world_dir(&K->lens, lp__unit_perp(e, dir));
     f[F_OX][j] = o.x;
     f[F_OY][j] = o.y;
     f[F_OZ][j] = o.z;
@@ -408,17 +240,17 @@ LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__la
         lp_vec3 d = v3(in->dx[j], in->dy[j], in->dz[j]);
         lp_vec3 vp = v3(in->vx[j], in->vy[j], in->vz[j]);
         double I0 = in->intensity[j];
-        int on = on_lens(K, p), odd;
-        double t0, t1, tr;
-        int h0 = cap_far(K->c[0], K->z0[0], K->hh[0], p, d, 0.0, &t0);
-        int h1 = cap_far(K->c[1], K->z0[1], K->hh[1], p, d, 0.0, &t1);
-        int b1 = h1 & (!h0 | (t1 < t0));
-        int cap = h0 | h1;
-        double best = b1 ? t1 : (h0 ? t0 : INFINITY);
-        int rim = (K->has_rim != 0.0) & rim_hit(K, p, d, 0.0, &tr) & (tr < best);
-        double surf = b1 ? 1.0 : 0.0;
-        lp_vec3 x = v3_madd(p, d, best);
-        lp_vec3 n = cap_normal(K, surf, x);
+        int on = lp__lane_on_lens(&K->lens, p), odd;
+        double best;
+        lp_vec3 x;
+        int rim;
+        double hs = lp__lane_hit_outside(&K->lens, p, d, &best, &x, &rim);
+        int cap = hs >= 0.0;
+        double surf = hs == 1.0 ? 1.0 : 0.0;
+        /* the rim, for the lanes that could meet it: see entry_rim */
+        L->rim[j] = rim ? 1.0 : 0.0;
+        L->t[j] = best;
+        lp_vec3 n = lp__lane_cap_normal(&K->lens, surf, x);
         lp_vec3 E = v3_scale(vp, sqrt(I0));
         node_out o;
         node(law, K->nm, K->ng, K->eta_in, K->r0_in, d, n, E, v3(0.0, 0.0, 0.0), &o, &odd);
@@ -440,7 +272,7 @@ LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__la
         L->cut[j] = K->cut_w * I0;
         /* what became of the ray (a start on the lens changes the hit;
          * odd nodes at the entry are the one-ray code's) */
-        double what = rim ? RAY_RIM : (cap ? (odd ? RAY_BACK : RAY_CHAIN) : RAY_MISS);
+        double what = cap ? (odd ? RAY_BACK : RAY_CHAIN) : RAY_MISS;
         what = on ? RAY_BACK : what;
         L->hs[j] = L->take[j] != 0.0 ? what : RAY_OFF;
     }
@@ -461,23 +293,12 @@ LP__INLINE void hit_step(lp__lanes *restrict L, const consts *Kp)
         int live = was & !cut;
         L->live[c] = live ? 1.0 : 0.0;
         L->cut_now[c] = cut ? 1.0 : 0.0;
-        /* the cap the lane is on (self), the other one from eps on */
-        int on1 = L->surf[c] == 1.0;
-        double ts, to;
-        int hself = cap_self(on1 ? K->c[1] : K->c[0], on1 ? K->z0[1] : K->z0[0],
-                             on1 ? K->hh[1] : K->hh[0], p, d, 0.0, &ts);
-        int hother = cap_far(on1 ? K->c[0] : K->c[1], on1 ? K->z0[0] : K->z0[1],
-                             on1 ? K->hh[0] : K->hh[1], p, d, K->eps, &to);
-        int off1 = !on1;
-        int h0 = (on1 & hother) | (off1 & hself), h1 = (on1 & hself) | (off1 & hother);
-        double t0 = on1 ? to : ts, t1 = on1 ? ts : to;
-        int b1 = h1 & (!h0 | (t1 < t0));
-        int cap = h0 | h1;
-        double best = b1 ? t1 : (h0 ? t0 : INFINITY);
-        lp_vec3 x = v3_madd(p, d, best);
-        int rim = (K->has_rim != 0.0) & !(cap & inside_rim(K, p) & inside_rim(K, x));
+        double best;
+        lp_vec3 x;
+        int rim;
+        double hs = lp__lane_hit_inside(&K->lens, p, d, L->surf[c], &best, &x, &rim);
         L->t[c] = best;
-        L->hs[c] = cap ? (b1 ? 1.0 : 0.0) : -1.0;
+        L->hs[c] = hs;
         L->hx[c] = x.x;
         L->hy[c] = x.y;
         L->hz[c] = x.z;
@@ -491,10 +312,10 @@ LP__WIDE static void entry_kernel(lp__lanes *restrict L, const consts *K, const 
                                   size_t m, int law)
 {
     switch (law) {
-    case LAW_POLARIZED: entry_step(L, K, in, m, LAW_POLARIZED); break;
-    case LAW_FRESNEL: entry_step(L, K, in, m, LAW_FRESNEL); break;
-    case LAW_SCHLICK_CI: entry_step(L, K, in, m, LAW_SCHLICK_CI); break;
-    default: entry_step(L, K, in, m, LAW_SCHLICK_CT); break;
+    case LP__LAW_POLARIZED: entry_step(L, K, in, m, LP__LAW_POLARIZED); break;
+    case LP__LAW_FRESNEL: entry_step(L, K, in, m, LP__LAW_FRESNEL); break;
+    case LP__LAW_SCHLICK_CI: entry_step(L, K, in, m, LP__LAW_SCHLICK_CI); break;
+    default: entry_step(L, K, in, m, LP__LAW_SCHLICK_CT); break;
     }
 }
 
@@ -513,7 +334,7 @@ static void rim_step(lp__lanes *restrict L, const consts *K)
         lp_vec3 p = v3(L->px[c], L->py[c], L->pz[c]);
         lp_vec3 d = v3(L->dx[c], L->dy[c], L->dz[c]);
         double t;
-        if (lp__rim_intersect(&K->r, p, d, K->eps, L->t[c], &t)) {
+        if (lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, L->t[c], &t)) {
             lp_vec3 x = v3_madd(p, d, t);
             L->t[c] = t;
             L->hs[c] = 2.0;
@@ -522,6 +343,21 @@ static void rim_step(lp__lanes *restrict L, const consts *K)
             L->hz[c] = x.z;
             L->em[c] = K->ha * t;
         }
+    }
+}
+
+/* The entry's rim test (lp__lens_hit from outside the lens) of the rays
+ * that could meet it: a hit before the cap's absorbs the ray. */
+static void entry_rim(lp__lanes *restrict L, const consts *K, const lp__lane_in *in, size_t m)
+{
+    for (size_t j = 0; j < m; j++) {
+        if (L->rim[j] == 0.0 || L->take[j] == 0.0 || L->hs[j] == RAY_BACK)
+            continue;
+        lp_vec3 p = v3(in->px[j], in->py[j], in->pz[j]);
+        lp_vec3 d = v3(in->dx[j], in->dy[j], in->dz[j]);
+        double t;
+        if (lp__rim_intersect(&K->lens.r, p, d, 0.0, L->t[j], &t))
+            L->hs[j] = RAY_RIM;
     }
 }
 
@@ -552,7 +388,7 @@ LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law, doub
         f[F_ENDVAL][c] = cut ? L->pw[c] : power_of(E, F);
         int leak = was & (hs < 0.0);
         int live = was & !rim & !leak;
-        lp_vec3 nrm = cap_normal(K, hs, x);
+        lp_vec3 nrm = lp__lane_cap_normal(&K->lens, hs, x);
         node_out o;
         int odd;
         node(law, K->ng, K->nm, K->eta_out, K->r0_out, d, nrm, E, F, &o, &odd);
@@ -611,10 +447,10 @@ LP__WIDE static void node_kernel(lp__lanes *restrict L, const consts *K, int law
                                  double (*restrict f)[NL])
 {
     switch (law) {
-    case LAW_POLARIZED: node_step(L, K, LAW_POLARIZED, f); break;
-    case LAW_FRESNEL: node_step(L, K, LAW_FRESNEL, f); break;
-    case LAW_SCHLICK_CI: node_step(L, K, LAW_SCHLICK_CI, f); break;
-    default: node_step(L, K, LAW_SCHLICK_CT, f); break;
+    case LP__LAW_POLARIZED: node_step(L, K, LP__LAW_POLARIZED, f); break;
+    case LP__LAW_FRESNEL: node_step(L, K, LP__LAW_FRESNEL, f); break;
+    case LP__LAW_SCHLICK_CI: node_step(L, K, LP__LAW_SCHLICK_CI, f); break;
+    default: node_step(L, K, LP__LAW_SCHLICK_CT, f); break;
     }
 }
 
@@ -712,6 +548,7 @@ static void run(lp__lanes *restrict L, const consts *K, const lp_lens *lens,
                 lp_mode mode, int law_in, int law_out)
 {
     entry_kernel(L, K, in, m, law_in);
+    entry_rim(L, K, in, m);
     pack(L, in, m);
     int absorbs = L->absorbs;
     L->staged = 1;
@@ -754,13 +591,13 @@ void lp__lanes_run(lp__lanes *L, const lp_lens *lens, const lp__optics *o,
     lp_mode mode = a->mode;
     int depth = a->max_depth;
     if (mode == LP_MODE_POLARIZED)
-        run(L, &K, lens, o, in, m, depth, mode, LAW_POLARIZED, LAW_POLARIZED);
+        run(L, &K, lens, o, in, m, depth, mode, LP__LAW_POLARIZED, LP__LAW_POLARIZED);
     else if (mode == LP_MODE_FRESNEL)
-        run(L, &K, lens, o, in, m, depth, mode, LAW_FRESNEL, LAW_FRESNEL);
+        run(L, &K, lens, o, in, m, depth, mode, LP__LAW_FRESNEL, LP__LAW_FRESNEL);
     else if (o->n_medium > o->n_glass)
-        run(L, &K, lens, o, in, m, depth, mode, LAW_SCHLICK_CT, LAW_SCHLICK_CI);
+        run(L, &K, lens, o, in, m, depth, mode, LP__LAW_SCHLICK_CT, LP__LAW_SCHLICK_CI);
     else
-        run(L, &K, lens, o, in, m, depth, mode, LAW_SCHLICK_CI, LAW_SCHLICK_CT);
+        run(L, &K, lens, o, in, m, depth, mode, LP__LAW_SCHLICK_CI, LP__LAW_SCHLICK_CT);
     for (size_t j = 0; j < m; j++)
         if (L->ray[j] == RAY_CHAIN && L->back[L->lane[j]] != 0.0)
             L->ray[j] = RAY_BACK;
