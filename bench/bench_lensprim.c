@@ -199,6 +199,34 @@ int main(int argc, char **argv)
             if (only_column)
                 printf("nodes: fwd %zu batch %zu soa %zu bwd %zu\n", nodes, batch_nodes, soa_nodes,
                        bnodes);
+            /* one view ray at 16 wavelengths: 16 builds, or one call */
+            if (RUN("build16") || RUN("build16many")) {
+                enum { NW = 16 };
+                lp_backward *bws[NW];
+                double lam[NW];
+                for (int k = 0; k < NW; k++) {
+                    lp_backward_create(&bws[k], &err);
+                    lam[k] = 400.0 + 20.0 * k;
+                }
+                size_t views = n / 4;
+                t0 = now();
+                for (size_t i = 0; i < views && RUN("build16"); i++)
+                    for (int k = 0; k < NW; k++)
+                        lp_backward_build(bws[k], lens, rays[i].origin, rays[i].dir, lam[k], &a,
+                                          NULL);
+                double t_one = now() - t0;
+                t0 = now();
+                for (size_t i = 0; i < views; i++)
+                    lp_backward_build_many(bws, NW, lens, rays[i].origin, rays[i].dir, lam, &a,
+                                           NULL);
+                double t_many = now() - t0;
+                printf("build16: one view ray at 16 wavelengths: 16 builds %.3f us, "
+                       "lp_backward_build_many %.3f us (%.2fx)\n",
+                       1e6 * t_one / (double)views, 1e6 * t_many / (double)views,
+                       t_one / t_many);
+                for (int k = 0; k < NW; k++)
+                    lp_backward_destroy(bws[k]);
+            }
         }
     }
     lp_backward_destroy(bw);

@@ -263,14 +263,15 @@ LP__INLINE void lp__lane_node_at(double n1, double n2, double eta, lp_vec3 d, lp
  * copy of the loops, so that each is free of branches. */
 enum { LP__LAW_POLARIZED, LP__LAW_FRESNEL, LP__LAW_SCHLICK_CI, LP__LAW_SCHLICK_CT };
 
-/* The power reflectance of an unpolarized law (lp__node_reflectance):
- * Schlick's with r0 = ((n1 - n2)/(n1 + n2))^2, or (Rs + Rp)/2; 1 under
- * total internal reflection. */
-LP__INLINE double lp__lane_reflectance(int law, double r0, const lp__lane_node *g)
+/* The power reflectance of an unpolarized mode (lp__node_reflectance):
+ * Schlick's (schlick set) with r0 = ((n1 - n2)/(n1 + n2))^2 and the
+ * refracted cosine when use_ct (n1 > n2), or (Rs + Rp)/2; 1 under total
+ * internal reflection. */
+LP__INLINE double lp__lane_reflectance(int schlick, double r0, int use_ct, const lp__lane_node *g)
 {
     double R;
-    if (law == LP__LAW_SCHLICK_CI || law == LP__LAW_SCHLICK_CT) {
-        double m = 1.0 - (law == LP__LAW_SCHLICK_CT ? g->ct : g->ci);
+    if (schlick) {
+        double m = 1.0 - (use_ct ? g->ct : g->ci);
         double m2 = m * m;
         R = r0 + (1.0 - r0) * m2 * m2 * m;
     } else {

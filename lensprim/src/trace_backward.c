@@ -16,36 +16,9 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "backward.h"
 #include "error.h"
 #include "interface.h"
-#include "trace.h"
-#include "trace_crystal.h"
-
-typedef struct bw_node {
-    lp_vec3 p;       /* local point */
-    lp_vec3 n;       /* outward normal */
-    lp_vec3 e_out;   /* eye direction inside the glass leaving this node */
-    double seg;      /* length from this node to the next one */
-    double seg_att;  /* amplitude factor over seg: exp(-alpha seg / 2) */
-    double seg_abs;  /* power fraction absorbed over seg: 1 - seg_att^2 */
-    int surface;
-} bw_node;
-
-struct lp_backward {
-    const lp_lens *lens;
-    lp_trace_args args;
-    lp__optics optics;
-    lp_vec3 view_dir;              /* local e_0 */
-    int n_nodes;
-    bw_node node[LP_MAX_DEPTH + 1]; /* node[1..n_nodes] */
-    size_t n_queries;
-    lp_query query[LP_MAX_DEPTH];
-    lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
-    lp__exit exit;                   /* where gathered light leaves */
-    int rim_depth;
-    unsigned warnings;
-    lp__xback *xb;                 /* the last build's, through a crystal */
-};
 
 lp_status lp_backward_create(lp_backward **out, lp_error *err)
 {
@@ -120,8 +93,8 @@ static void light_node(const lp_backward *bw, int j, lp__node *nd)
                    bw->optics.n_medium, NULL);
 }
 
-static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
-                      uint64_t path, double op, double bound, double weight)
+void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
+                            uint64_t path, double op, double bound, double weight)
 {
     lp_query *q = &bw->query[bw->n_queries];
     lp_branch_info info;
@@ -196,8 +169,8 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     lp__branch br;
     lp__cvec3 zero = {0, 0, 0};
     lp__node_reflect(&nd, mode, &zero, &br);
-    add_query(bw, 1, LP_KIND_REFLECT, h.surface, br.dir, 1u, 0.0, node_bound(&nd, mode, 1),
-              node_weight(&nd, mode, 1));
+    lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, br.dir, 1u, 0.0,
+                           node_bound(&nd, mode, 1), node_weight(&nd, mode, 1));
     if (tir) {
         lp__ok(err);
         return LP_OK;
@@ -237,9 +210,10 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
         tir = lp__node_setup(&nd, d, h.n, o->n_glass, o->n_medium, NULL);
         if (!tir) {
             lp__node_transmit(&nd, mode, &zero, &br);
-            add_query(bw, depth, h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
-                      h.surface, br.dir, path, op, bound * node_bound(&nd, mode, 0),
-                      weight * node_weight(&nd, mode, 0));
+            lp__backward_add_query(bw, depth,
+                                   h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
+                                   h.surface, br.dir, path, op, bound * node_bound(&nd, mode, 0),
+                                   weight * node_weight(&nd, mode, 0));
         }
         lp__node_reflect(&nd, mode, &zero, &br);
         bound *= node_bound(&nd, mode, 1);

@@ -176,7 +176,8 @@ LP__INLINE void node(int law, double n1, double n2, double eta, double r0, lp_ve
         rsi = ks * esi + ki * es;
         rpi = kp * epi + ki * ep;
     } else {
-        double R = lp__lane_reflectance(law, r0, &g);
+        double R =
+            lp__lane_reflectance(law != LP__LAW_FRESNEL, r0, law == LP__LAW_SCHLICK_CT, &g);
         double T = 1.0 - R;
         double kt = sqrt(T > 0.0 ? T : 0.0), kr = sqrt(R);
         o->flip = 0.0;
