@@ -40,4 +40,10 @@ struct lp_backward {
 void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
                             uint64_t path, double op, double bound, double weight);
 
+/* The same with the query's world origin (of bw->node[depth].p) and world
+ * direction (of dir) given. */
+void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
+                               lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
+                               uint64_t path, double op, double bound, double weight);
+
 #endif

@@ -12,7 +12,7 @@
  * rim tests of the lanes near the rim and the absorption's expm1 are the
  * one-ray code's, lane by lane.  Each step writes its nodes straight into
  * the lanes' lp_backward; the queries are made at the end, wavelength by
- * wavelength in depth order (lp__backward_add_query: the flags and the
+ * wavelength in depth order (lp__backward_add_query_at: the flags and the
  * filter are called in the order of lp_backward_build). */
 #include <math.h>
 #include <string.h>
@@ -39,6 +39,8 @@ typedef struct wl_lanes {
     /* the node there: normal, the query's direction, bound and weight */
     double nx[NW], ny[NW], nz[NW];
     double qx[NW], qy[NW], qz[NW], qb[NW], qw[NW], tir[NW];
+    /* the query in the world: its origin (the node) and direction */
+    double wox[NW], woy[NW], woz[NW], wdx[NW], wdy[NW], wdz[NW];
 } wl_lanes;
 
 /* The bound and weight factors of a node (trace_backward.c's node_bound
@@ -64,16 +66,22 @@ LP__INLINE void factors(lp_mode mode, double r0, double n1, double n2, const lp_
 
 /* Node 1 of every lane: the view ray enters at the point of the unit
  * normal hn, along d; the reflected query and the refracted chain. */
-LP__INLINE void entry_step(wl_lanes *restrict W, size_t n, lp_mode mode, lp_vec3 d, lp_vec3 hn)
+LP__INLINE void entry_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp, lp_mode mode,
+                           lp_vec3 d, lp_vec3 hn)
 {
+    const lp__lane_lens K = *Kp; /* local: the loads are safe to select */
     for (size_t k = 0; k < n; k++) {
         lp__lane_node g;
         double bR, bT, wR, wT;
         lp__lane_node_at(W->nm[k], W->ng[k], W->eta_in[k], d, hn, &g);
         factors(mode, W->r0_in[k], W->nm[k], W->ng[k], &g, &bR, &bT, &wR, &wT);
+        lp_vec3 wd = lp__lane_world_dir(&K, g.r);
         W->qx[k] = g.r.x;
         W->qy[k] = g.r.y;
         W->qz[k] = g.r.z;
+        W->wdx[k] = wd.x;
+        W->wdy[k] = wd.y;
+        W->wdz[k] = wd.z;
         W->qb[k] = bR;
         W->qw[k] = wR;
         W->tir[k] = g.tir ? 1.0 : 0.0;
@@ -132,9 +140,16 @@ LP__INLINE void node_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *K
         W->nx[k] = nrm.x;
         W->ny[k] = nrm.y;
         W->nz[k] = nrm.z;
+        lp_vec3 wo = lp__lane_world_point(&K, x), wd = lp__lane_world_dir(&K, g.t);
         W->qx[k] = g.t.x;
         W->qy[k] = g.t.y;
         W->qz[k] = g.t.z;
+        W->wox[k] = wo.x;
+        W->woy[k] = wo.y;
+        W->woz[k] = wo.z;
+        W->wdx[k] = wd.x;
+        W->wdy[k] = wd.y;
+        W->wdz[k] = wd.z;
         W->qb[k] = bound * bT;
         W->qw[k] = weight * wT;
         W->tir[k] = g.tir ? 1.0 : 0.0;
@@ -151,13 +166,13 @@ LP__INLINE void node_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *K
 }
 
 /* The vector loops, each in one copy per mode and vector width. */
-LP__WIDE static void entry_kernel(wl_lanes *restrict W, size_t n, lp_mode mode, lp_vec3 d,
-                                  lp_vec3 hn)
+LP__WIDE static void entry_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K,
+                                  lp_mode mode, lp_vec3 d, lp_vec3 hn)
 {
     switch (mode) {
-    case LP_MODE_POLARIZED: entry_step(W, n, LP_MODE_POLARIZED, d, hn); break;
-    case LP_MODE_FRESNEL: entry_step(W, n, LP_MODE_FRESNEL, d, hn); break;
-    default: entry_step(W, n, LP_MODE_SCHLICK, d, hn); break;
+    case LP_MODE_POLARIZED: entry_step(W, n, K, LP_MODE_POLARIZED, d, hn); break;
+    case LP_MODE_FRESNEL: entry_step(W, n, K, LP_MODE_FRESNEL, d, hn); break;
+    default: entry_step(W, n, K, LP_MODE_SCHLICK, d, hn); break;
     }
 }
 
@@ -178,17 +193,18 @@ LP__WIDE static void node_kernel(wl_lanes *restrict W, size_t n, const lp__lane_
 }
 
 /* A query candidate of node `depth` (the transmitted branch; node 1's
- * reflected one), kept in the builder's own query slot depth - 1 until
- * lp__backward_add_query makes the queries: so no scratch is needed. */
-static void keep_candidate(lp_backward *bw, int depth, lp_vec3 dir, double op, double bound,
-                           double weight)
+ * reflected one) of lane k, kept in the builder's own query slot
+ * depth - 1 until lp__backward_add_query_at makes the queries: so no
+ * scratch is needed. */
+static void keep_candidate(lp_backward *bw, int depth, const wl_lanes *W, size_t k, lp_vec3 wo)
 {
     lp_query *q = &bw->query[depth - 1];
-    bw->query_dir[depth - 1] = dir;
-    q->depth = depth;
-    q->op = op;
-    q->bound = bound;
-    q->weight = weight;
+    bw->query_dir[depth - 1] = v3(W->qx[k], W->qy[k], W->qz[k]);
+    q->origin = wo;
+    q->dir = v3(W->wdx[k], W->wdy[k], W->wdz[k]);
+    q->op = W->op[k];
+    q->bound = W->qb[k];
+    q->weight = W->qw[k];
 }
 
 /* Wavelengths k0 .. k0+n of a cap hit h of the view ray (local
@@ -214,8 +230,9 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         W.px[k] = h->p.x, W.py[k] = h->p.y, W.pz[k] = h->p.z;
         W.surf[k] = h->surface;
     }
-    entry_kernel(&W, n, mode, d, h->n);
+    entry_kernel(&W, n, K, mode, d, h->n);
     lp__exit exit = lp__exit_at(lens, h->p, v3_neg(d));
+    lp_vec3 wo1 = lp__to_world_point(lens, h->p);
     for (size_t k = 0; k < n; k++) {
         lp_backward *b = bw[k];
         b->exit = exit;
@@ -224,7 +241,7 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         b->node[1].n = h->n;
         b->node[1].surface = h->surface;
         b->node[1].e_out = v3(W.dx[k], W.dy[k], W.dz[k]);
-        keep_candidate(b, 1, v3(W.qx[k], W.qy[k], W.qz[k]), 0.0, W.qb[k], W.qw[k]);
+        keep_candidate(b, 1, &W, k, wo1);
         cand[k][1] = 1;
     }
     /* the chains, a node per step */
@@ -275,8 +292,7 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
             b->n_nodes = depth + 1;
             cand[k][depth + 1] = W.tir[k] == 0.0;
             if (cand[k][depth + 1])
-                keep_candidate(b, depth + 1, v3(W.qx[k], W.qy[k], W.qz[k]), W.op[k], W.qb[k],
-                               W.qw[k]);
+                keep_candidate(b, depth + 1, &W, k, v3(W.wox[k], W.woy[k], W.woz[k]));
         }
     }
     /* the queries, wavelength by wavelength, in depth order */
@@ -285,13 +301,12 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         uint64_t path = 0;
         for (int j = 1; j <= b->n_nodes; j++) {
             if (cand[k][j]) {
-                const lp_query *q = &b->query[j - 1];
-                double op = q->op, bound = q->bound, weight = q->weight;
+                lp_query q = b->query[j - 1];
                 lp_vec3 dir = b->query_dir[j - 1];
                 int surface = b->node[j].surface;
                 lp_kind kind = j == 1 || surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
-                lp__backward_add_query(b, j, kind, surface, dir, j == 1 ? 1u : path, op, bound,
-                                       weight);
+                lp__backward_add_query_at(b, j, kind, surface, dir, q.origin, q.dir,
+                                          j == 1 ? 1u : path, q.op, q.bound, q.weight);
             }
             if (j > 1)
                 path |= (uint64_t)1 << (j - 1);

@@ -96,15 +96,22 @@ static void light_node(const lp_backward *bw, int j, lp__node *nd)
 void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
                             uint64_t path, double op, double bound, double weight)
 {
-    lp_query *q = &bw->query[bw->n_queries];
-    lp_branch_info info;
+    lp__backward_add_query_at(bw, depth, kind, surface, dir,
+                              lp__to_world_point(bw->lens, bw->node[depth].p),
+                              lp__to_world_dir(bw->lens, dir), path, op, bound, weight);
+}
 
-    if (bound < bw->args.min_weight ||
-        !lp__branch_keep(bw->lens, &bw->args, depth, kind, surface, bw->node[depth].p, dir,
-                         bound, &info))
+void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
+                               lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
+                               uint64_t path, double op, double bound, double weight)
+{
+    lp_query *q = &bw->query[bw->n_queries];
+    lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
+
+    if (bound < bw->args.min_weight || !lp__args_keep(&bw->args, &info))
         return;
-    q->origin = info.origin;
-    q->dir = info.dir;
+    q->origin = world_origin;
+    q->dir = world_dir;
     q->depth = depth;
     q->kind = kind;
     q->surface = surface;
@@ -165,22 +172,19 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     bw->node[1].p = h.p;
     bw->node[1].n = h.n;
     bw->node[1].surface = h.surface;
-    int tir = lp__node_setup(&nd, d, h.n, o->n_medium, o->n_glass, NULL);
-    lp__branch br;
-    lp__cvec3 zero = {0, 0, 0};
-    lp__node_reflect(&nd, mode, &zero, &br);
-    lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, br.dir, 1u, 0.0,
+    /* the branches' directions and powers (no fields) */
+    int tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_medium, o->n_glass);
+    lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, lp__node_reflect_dir(&nd), 1u, 0.0,
                            node_bound(&nd, mode, 1), node_weight(&nd, mode, 1));
     if (tir) {
         lp__ok(err);
         return LP_OK;
     }
 
-    lp__node_transmit(&nd, mode, &zero, &br);
     double bound = node_bound(&nd, mode, 0), weight = node_weight(&nd, mode, 0), op = 0.0;
     uint64_t path = 0;
     int depth = 1;
-    d = br.dir;
+    d = lp__node_transmit_dir(&nd);
     p = h.p;
     int surface = h.surface;
     bw->node[1].e_out = d;
@@ -207,19 +211,17 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
         bw->node[depth].p = h.p;
         bw->node[depth].n = h.n;
         bw->node[depth].surface = h.surface;
-        tir = lp__node_setup(&nd, d, h.n, o->n_glass, o->n_medium, NULL);
-        if (!tir) {
-            lp__node_transmit(&nd, mode, &zero, &br);
+        tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_glass, o->n_medium);
+        if (!tir)
             lp__backward_add_query(bw, depth,
                                    h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
-                                   h.surface, br.dir, path, op, bound * node_bound(&nd, mode, 0),
+                                   h.surface, lp__node_transmit_dir(&nd), path, op,
+                                   bound * node_bound(&nd, mode, 0),
                                    weight * node_weight(&nd, mode, 0));
-        }
-        lp__node_reflect(&nd, mode, &zero, &br);
         bound *= node_bound(&nd, mode, 1);
         weight *= node_weight(&nd, mode, 1);
         path |= (uint64_t)1 << (depth - 1);
-        d = br.dir;
+        d = lp__node_reflect_dir(&nd);
         p = h.p;
         surface = h.surface;
         bw->node[depth].e_out = d;
