@@ -1,17 +1,27 @@
 /* bench_lensprim.c -- lens-tree nodes per second per core.
  *
  * A benchmark, not a test: it traces random rays through the default lens
- * (biconvex N-BK7, R 50/-50, t 8, D 25) in each mode and depth, forward
- * (one call per ray, lp_trace_forward_many, and lp_trace_forward_soa on
- * groups of 64 rays, each group at one wavelength) and backward (build +
- * gather of a one-ray bundle per query), on one thread, and prints
- * nodes/s and the time ratio of each mode to polarized measured in the
- * same run.  Times are the CPU time of the tracing thread (not wall
- * clock), so nodes/s is per core even on a machine that other programs
- * share.  Usage:
+ * (biconvex N-BK7, R 50/-50, t 8, D 25) in each mode and depth, on one
+ * thread, and prints nodes per second in these columns:
+ *   fwd      lp_trace_forward, one call per ray
+ *   batch    lp_trace_forward_many on all rays (every ray at its own
+ *            wavelength: the one-ray code)
+ *   soa64    lp_trace_forward_soa on groups of 64 rays, each group at one
+ *            wavelength (the lane engine)
+ *   soa1k    the same on groups of 1024 rays
+ *   bwd      lp_backward_build and lp_backward_gather of a one-ray bundle
+ *            per query
+ * and the time ratio of each mode's fwd to polarized measured in the same
+ * run.  Then, per row, one view ray built at 16 wavelengths (400..700
+ * nm): 16 calls of lp_backward_build against one lp_backward_build_many,
+ * in microseconds per view ray.  Times are the CPU time of the tracing
+ * thread (not wall clock), so nodes/s is per core even on a machine that
+ * other programs share.  Usage:
  *     bench_lensprim [RAYS] [--mode polarized|fresnel|schlick] [--depth N]
- * RAYS defaults to 200000; --mode and --depth keep one row each (for a
- * profiler); without them every mode at depths 2, 5 and 20 is printed. */
+ *                    [--column fwd|batch|soa64|soa1k|bwd|build16|build16many]
+ * RAYS defaults to 200000; --mode and --depth keep one row each, --column
+ * one column (for a profiler: build16many times lp_backward_build_many
+ * alone); without them every mode at depths 2, 5 and 20 is printed. */
 #define _POSIX_C_SOURCE 199309L
 #include <math.h>
 #include <stdint.h>
@@ -90,9 +100,10 @@ int main(int argc, char **argv)
         } else if (argv[i][0] != '-' && strtoul(argv[i], NULL, 10) > 0) {
             n = strtoul(argv[i], NULL, 10);
         } else {
-            fprintf(stderr, "usage: bench_lensprim [RAYS] [--mode M] [--depth N]\n"
+            fprintf(stderr, "usage: bench_lensprim [RAYS] [--mode M] [--depth N] [--column C]\n"
                             "  prints lens-tree nodes per second of this thread's CPU time\n"
-                            "  (per core), forward, batch, arrays and backward\n");
+                            "  (per core): forward, batch, arrays in groups of 64 and 1024,\n"
+                            "  backward; and one view ray built at 16 wavelengths\n");
             return 2;
         }
     }
@@ -115,7 +126,6 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < n; i++)
         random_ray(&rays[i]);
     /* the same rays as arrays for lp_trace_forward_soa */
-    const size_t soa_group = 64;
     double *soa = malloc(10 * n * sizeof *soa);
     if (!soa)
         return 1;
@@ -135,8 +145,8 @@ int main(int argc, char **argv)
     lp_backward_create(&bw, &err);
 
     printf("%zu rays, one thread, nodes per CPU second of the thread\n", n);
-    printf("%-10s %5s %14s %14s %14s %14s %10s\n", "mode", "depth", "fwd nodes/s",
-           "batch nodes/s", "soa nodes/s", "bwd nodes/s", "fwd t/pol");
+    printf("%-10s %5s %11s %11s %11s %11s %11s %9s\n", "mode", "depth", "fwd", "batch", "soa64",
+           "soa1k", "bwd", "fwd t/pol");
     for (int di = 0; di < n_depths; di++) {
         double t_pol = 0.0;
         for (int m = 0; m < 3; m++) {
@@ -146,59 +156,74 @@ int main(int argc, char **argv)
             lp_trace_args_init(&a);
             a.mode = (lp_mode)m;
             a.max_depth = only_depth ? only_depth : depths[di];
+            double rate[5] = {0, 0, 0, 0, 0}; /* nodes/s per column, 0: not run */
+            size_t nodes[5] = {0, 0, 0, 0, 0};
+            double t_fwd = 0.0;
 
 #define RUN(name) (!only_column || strcmp(only_column, name) == 0)
-            size_t nodes = 0;
-            double t0 = now();
-            for (size_t i = 0; i < n && RUN("fwd"); i++) {
-                lp_trace_forward(lens, &rays[i], &a, &res, NULL);
-                nodes += res.nodes;
-            }
-            double t_fwd = now() - t0;
-
-            t0 = now();
-            if (RUN("batch"))
-                lp_trace_forward_many(lens, rays, n, &a, &res, offsets, NULL);
-            double t_batch = now() - t0;
-            size_t batch_nodes = res.nodes;
-
-            /* the arrays entry point, one wavelength per call: the rays in
-             * groups of soa_group, each group at its first ray's lambda */
-            size_t soa_nodes = 0;
-            t0 = now();
-            for (size_t i = 0; i < n && RUN("soa"); i += soa_group) {
-                size_t m = n - i < soa_group ? n - i : soa_group;
-                lp_ray_soa s = {sox + i, soy + i, soz + i, sdx + i, sdy + i, sdz + i, svx + i,
-                                svy + i, svz + i, sin_ + i, NULL, NULL, NULL, NULL};
-                lp_trace_forward_soa(lens, rays[i].lambda_nm, &s, m, &a, &res, offsets, NULL);
-                soa_nodes += res.nodes;
-            }
-            double t_soa = now() - t0;
-
-            size_t bnodes = 0;
-            t0 = now();
-            for (size_t i = 0; i < n && RUN("bwd"); i++) {
-                lp_backward_build(bw, lens, rays[i].origin, rays[i].dir, rays[i].lambda_nm, &a,
-                                  NULL);
-                size_t nq = lp_backward_query_count(bw);
-                const lp_query *q = lp_backward_queries(bw);
-                lp_result_clear(&res);
-                for (size_t k = 0; k < nq; k++) {
-                    lp_ray b = rays[i];
-                    b.vp = fabs(q[k].dir.z) < 0.9 ? (lp_vec3){0, 0, 1} : (lp_vec3){1, 0, 0};
-                    lp_backward_gather(bw, k, &b, 1, &res, NULL);
+            if (RUN("fwd")) {
+                double t0 = now();
+                for (size_t i = 0; i < n; i++) {
+                    lp_trace_forward(lens, &rays[i], &a, &res, NULL);
+                    nodes[0] += res.nodes;
                 }
-                bnodes += res.nodes;
+                t_fwd = now() - t0;
+                rate[0] = nodes[0] / t_fwd;
             }
-            double t_bwd = now() - t0;
+            if (RUN("batch")) {
+                double t0 = now();
+                lp_trace_forward_many(lens, rays, n, &a, &res, offsets, NULL);
+                nodes[1] = res.nodes;
+                rate[1] = nodes[1] / (now() - t0);
+            }
+            /* the arrays entry point, one wavelength per call: the rays in
+             * groups, each group at its first ray's wavelength */
+            for (int g = 0; g < 2; g++) {
+                size_t group = g == 0 ? 64 : 1024;
+                if (!RUN(g == 0 ? "soa64" : "soa1k"))
+                    continue;
+                double t0 = now();
+                for (size_t i = 0; i < n; i += group) {
+                    size_t k = n - i < group ? n - i : group;
+                    lp_ray_soa s = {sox + i, soy + i, soz + i, sdx + i, sdy + i, sdz + i,
+                                    svx + i, svy + i, svz + i, sin_ + i, NULL, NULL, NULL,
+                                    NULL};
+                    lp_trace_forward_soa(lens, rays[i].lambda_nm, &s, k, &a, &res, offsets,
+                                         NULL);
+                    nodes[2 + g] += res.nodes;
+                }
+                rate[2 + g] = nodes[2 + g] / (now() - t0);
+            }
+            if (RUN("bwd")) {
+                double t0 = now();
+                for (size_t i = 0; i < n; i++) {
+                    lp_backward_build(bw, lens, rays[i].origin, rays[i].dir, rays[i].lambda_nm,
+                                      &a, NULL);
+                    size_t nq = lp_backward_query_count(bw);
+                    const lp_query *q = lp_backward_queries(bw);
+                    lp_result_clear(&res);
+                    for (size_t k = 0; k < nq; k++) {
+                        lp_ray b = rays[i];
+                        b.vp = fabs(q[k].dir.z) < 0.9 ? (lp_vec3){0, 0, 1} : (lp_vec3){1, 0, 0};
+                        lp_backward_gather(bw, k, &b, 1, &res, NULL);
+                    }
+                    nodes[4] += res.nodes;
+                }
+                rate[4] = nodes[4] / (now() - t0);
+            }
             if (m == 0)
                 t_pol = t_fwd;
-            printf("%-10s %5d %14.3e %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], a.max_depth,
-                   nodes / t_fwd, batch_nodes / t_batch, soa_nodes / t_soa, bnodes / t_bwd,
-                   t_pol > 0.0 ? t_fwd / t_pol : 1.0);
+            printf("%-10s %5d", mode_name[m], a.max_depth);
+            for (int c = 0; c < 5; c++) {
+                if (rate[c] > 0.0)
+                    printf(" %11.3e", rate[c]);
+                else
+                    printf(" %11s", "-");
+            }
+            printf(" %9.3f\n", t_pol > 0.0 && t_fwd > 0.0 ? t_fwd / t_pol : 1.0);
             if (only_column)
-                printf("nodes: fwd %zu batch %zu soa %zu bwd %zu\n", nodes, batch_nodes, soa_nodes,
-                       bnodes);
+                printf("nodes: fwd %zu batch %zu soa64 %zu soa1k %zu bwd %zu\n", nodes[0],
+                       nodes[1], nodes[2], nodes[3], nodes[4]);
             /* one view ray at 16 wavelengths: 16 builds, or one call */
             if (RUN("build16") || RUN("build16many")) {
                 enum { NW = 16 };
@@ -208,8 +233,8 @@ int main(int argc, char **argv)
                     lp_backward_create(&bws[k], &err);
                     lam[k] = 400.0 + 20.0 * k;
                 }
-                size_t views = n / 4;
-                t0 = now();
+                size_t views = n / 16 > 0 ? n / 16 : 1;
+                double t0 = now();
                 for (size_t i = 0; i < views && RUN("build16"); i++)
                     for (int k = 0; k < NW; k++)
                         lp_backward_build(bws[k], lens, rays[i].origin, rays[i].dir, lam[k], &a,
@@ -220,10 +245,10 @@ int main(int argc, char **argv)
                     lp_backward_build_many(bws, NW, lens, rays[i].origin, rays[i].dir, lam, &a,
                                            NULL);
                 double t_many = now() - t0;
-                printf("build16: one view ray at 16 wavelengths: 16 builds %.3f us, "
+                printf("%-10s %5d one view ray at 16 wavelengths: 16 builds %.3f us, "
                        "lp_backward_build_many %.3f us (%.2fx)\n",
-                       1e6 * t_one / (double)views, 1e6 * t_many / (double)views,
-                       t_one / t_many);
+                       mode_name[m], a.max_depth, 1e6 * t_one / (double)views,
+                       1e6 * t_many / (double)views, t_many > 0.0 ? t_one / t_many : 0.0);
                 for (int k = 0; k < NW; k++)
                     lp_backward_destroy(bws[k]);
             }

@@ -484,7 +484,9 @@ LP_API lp_status lp_trace_forward(const lp_lens *lens, const lp_ray *in,
 /* Many rays at once: the results of ray i are out->rays[offsets[i] ..
  * offsets[i+1]) and the bookkeeping is summed over all rays.  offsets has
  * n + 1 entries.  Stops at the first invalid ray (its index is in the
- * message). */
+ * message).  The rays are traced in order, each as lp_trace_forward
+ * traces it; consecutive rays of one wavelength are traced together as
+ * lp_trace_forward_soa traces them, with the same results, bit for bit. */
 LP_API lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in,
                                        size_t n, const lp_trace_args *args,
                                        lp_result *out, size_t *offsets,
@@ -512,8 +514,13 @@ typedef struct lp_ray_soa {
  * outgoing rays in the same order, the same offsets (n + 1 entries) and
  * the same bookkeeping, bit for bit.  What depends on the wavelength
  * alone (the indices, the absorption, the data-range check) is computed
- * once per call, and the checks and frame changes of the rays run in a
- * loop the compiler vectorizes across rays.  A wavelength that is not a
+ * once per call.  Through a glass lens the rays of a group walk their
+ * internal chains node by node together, in loops over the rays that the
+ * compiler vectorizes, compiled for the widest vectors of the machine
+ * (AVX-512, AVX2 or the baseline, chosen at load time, the same bits on
+ * each); what those loops leave (total internal reflection, normal
+ * incidence, a ray starting on the lens, a crystal) is done by the
+ * one-ray code.  A wavelength that is not a
  * finite number > 0 fails the call before any ray (also when n is 0).
  * NULL lens, out or offsets, a NULL in when n > 0, or a required array
  * that is NULL when n > 0 gives LP_ERROR_INVALID_ARGUMENT.  The first
