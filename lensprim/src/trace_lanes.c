@@ -281,7 +281,7 @@ LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__la
 
 /* The first half of a step from a node: the weight cut, the next
  * hit (lp__lens_hit from the cap the lane is on) but for the rim of the
- * lanes that could meet it (rim[c] = 1: see rim_step). */
+ * lanes that could meet it (rim[c] = 1: see between). */
 LP__INLINE void hit_step(lp__lanes *restrict L, const consts *Kp)
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
@@ -325,17 +325,22 @@ LP__WIDE static void hit_kernel(lp__lanes *restrict L, const consts *K)
     hit_step(L, K);
 }
 
-/* The rim test of the lanes near it, one by one (few lanes need it). */
-static void rim_step(lp__lanes *restrict L, const consts *K)
+/* Between a step's vector loops, lane by lane: the rim test of the lanes
+ * near it (few) and the absorption's expm1, both the one-ray code's.
+ * Returns the number of lanes still walking. */
+static size_t between(lp__lanes *restrict L, const consts *K, int absorbs)
 {
-    size_t n = L->n_chain;
+    size_t n = L->n_chain, live = 0;
     for (size_t c = 0; c < n; c++) {
-        if (L->rim[c] == 0.0)
+        if (L->live[c] == 0.0) {
+            L->em[c] = 0.0;
             continue;
+        }
+        live++;
+        double t;
         lp_vec3 p = v3(L->px[c], L->py[c], L->pz[c]);
         lp_vec3 d = v3(L->dx[c], L->dy[c], L->dz[c]);
-        double t;
-        if (lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, L->t[c], &t)) {
+        if (L->rim[c] != 0.0 && lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, L->t[c], &t)) {
             lp_vec3 x = v3_madd(p, d, t);
             L->t[c] = t;
             L->hs[c] = 2.0;
@@ -344,7 +349,9 @@ static void rim_step(lp__lanes *restrict L, const consts *K)
             L->hz[c] = x.z;
             L->em[c] = K->ha * t;
         }
+        L->em[c] = absorbs ? expm1(L->em[c]) : 0.0;
     }
+    return live;
 }
 
 /* The entry's rim test (lp__lens_hit from outside the lens) of the rays
@@ -554,22 +561,14 @@ static void run(lp__lanes *restrict L, const consts *K, const lp_lens *lens,
     int absorbs = L->absorbs;
     L->staged = 1;
     for (int depth = 1; depth < max_depth; depth++) {
-        size_t n = L->n_chain, live = 0, odd = 0;
         double (*f)[NL] = (double (*)[NL])(L->node + (size_t)(depth + 1) * NF * NL);
         hit_kernel(L, K);
-        rim_step(L, K);
-        for (size_t c = 0; c < n; c++)
-            live += L->live[c] != 0.0;
-        for (size_t c = 0; c < n; c++)
-            L->em[c] = absorbs && L->live[c] != 0.0 ? expm1(L->em[c]) : 0.0;
+        size_t live = between(L, K, absorbs);
         node_kernel(L, K, law_out, f);
         L->staged = depth + 1;
         if (live == 0)
             break;
-        for (size_t c = 0; c < n; c++)
-            odd += L->odd[c] != 0.0;
-        if (odd)
-            odd_step(L, lens, op, mode, f);
+        odd_step(L, lens, op, mode, f);
     }
     /* the lanes still walking stop at the depth */
     for (size_t c = 0; c < L->n_chain; c++)
