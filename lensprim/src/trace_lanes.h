@@ -15,31 +15,8 @@
 #ifndef LP_TRACE_LANES_H
 #define LP_TRACE_LANES_H
 
+#include "lanes.h"
 #include "trace.h"
-
-/* The helpers of the loops over lanes must be inlined, or the loops
- * cannot be vectorized. */
-#if defined(__GNUC__)
-#define LP__INLINE static inline __attribute__((always_inline))
-#else
-#define LP__INLINE static inline
-#endif
-
-/* The loops over lanes are compiled for the widest vectors of the
- * machine that runs them (AVX-512, AVX2, else the baseline), chosen once
- * when the program loads.  Every copy does the same operations in the
- * same order (the build keeps FP contraction off), so all give the same
- * bits. */
-#ifndef LP__WIDE /* a build may pin one copy (-DLP__WIDE=) to check it */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define LP__WIDE __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define LP__WIDE
-#endif
-#endif
-
-/* Rays per group. */
-#define LP__LANES 64
 
 /* A group's rays, checked and in the lens frame. */
 typedef struct lp__lane_in {
@@ -58,9 +35,9 @@ typedef struct lp__lanes lp__lanes;
 lp__lanes *lp__lanes_create(int max_depth);
 void lp__lanes_destroy(lp__lanes *L);
 
-/* Trace rays 0..m-1 (m <= LP__LANES) of a group at the optics o with the
- * resolved args a (a->max_depth no deeper than L's).  Nothing is added
- * to a result yet: see lp__lanes_emit. */
+/* Trace rays 0..m-1 (m <= LP__LANES, lanes.h) of a group at the optics o
+ * with the resolved args a (a->max_depth no deeper than L's).  Nothing
+ * is added to a result yet: see lp__lanes_emit. */
 void lp__lanes_run(lp__lanes *L, const lp_lens *lens, const lp__optics *o,
                    const lp_trace_args *a, const lp__lane_in *in, size_t m);
 
