@@ -61,7 +61,10 @@ lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E
                          int surface, uint64_t path, lp_error *err);
 
 /* x wrapped into [-pi, pi] (x itself when it lies there already). */
-double lp__wrap_phase(double x);
+static inline double lp__wrap_phase(double x)
+{
+    return fabs(x) <= LP_PI ? x : remainder(x, 2.0 * LP_PI);
+}
 
 /* Send one outgoing field (branch b, leaving the local point p) to the
  * result, or count its power as skipped when args' flags or filter

@@ -96,11 +96,6 @@ lp__exit lp__exit_at(const lp_lens *lens, lp_vec3 p, lp_vec3 d)
     return x;
 }
 
-double lp__wrap_phase(double x)
-{
-    return fabs(x) <= LP_PI ? x : remainder(x, 2.0 * LP_PI);
-}
-
 lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, double power,
                          const lp__exit *x, const lp__payload *pl, int depth, lp_kind kind,
                          int surface, uint64_t path, lp_error *err)

@@ -610,7 +610,7 @@ int lp__lanes_traced(const lp__lanes *L, size_t j)
 
 /* One outgoing ray of a node (lp__leave): kept (and appended when it
  * carries power) or counted as skipped. */
-static lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
+LP__INLINE lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
                        const double (*f)[NL], size_t j, const lp__payload *pl, double phase,
                        int depth, int kphi, double op, lp_kind kind, int surface, uint64_t path,
                        lp_error *err)
