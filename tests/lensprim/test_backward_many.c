@@ -30,6 +30,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "same_bits.h"
 #include "lensprim.h"
 
 #define PI 3.14159265358979323846
@@ -104,31 +105,6 @@ static int same_query(const lp_query *a, const lp_query *b)
            memcmp(&a->weight, &b->weight, sizeof a->weight) == 0 && a->waves == b->waves;
 }
 
-static int same_out(const lp_out_ray *a, const lp_out_ray *b)
-{
-    const lp_ray *x = &a->ray, *y = &b->ray;
-    return memcmp(&x->origin, &y->origin, sizeof x->origin) == 0 &&
-           memcmp(&x->dir, &y->dir, sizeof x->dir) == 0 &&
-           memcmp(&x->lambda_nm, &y->lambda_nm, sizeof(double)) == 0 &&
-           memcmp(&x->intensity, &y->intensity, sizeof(double)) == 0 &&
-           memcmp(&x->vp, &y->vp, sizeof x->vp) == 0 && x->kphi == y->kphi &&
-           memcmp(&x->op, &y->op, sizeof(double)) == 0 &&
-           memcmp(&x->phase, &y->phase, sizeof(double)) == 0 && x->ch == y->ch &&
-           a->depth == b->depth && a->kind == b->kind && a->surface == b->surface &&
-           a->part == b->part && a->path == b->path && a->waves == b->waves;
-}
-
-static int same_books(const lp_result *a, const lp_result *b)
-{
-    return memcmp(&a->in, &b->in, sizeof(double)) == 0 &&
-           memcmp(&a->out, &b->out, sizeof(double)) == 0 &&
-           memcmp(&a->skipped, &b->skipped, sizeof(double)) == 0 &&
-           memcmp(&a->absorbed_glass, &b->absorbed_glass, sizeof(double)) == 0 &&
-           memcmp(&a->absorbed_rim, &b->absorbed_rim, sizeof(double)) == 0 &&
-           memcmp(&a->truncated, &b->truncated, sizeof(double)) == 0 &&
-           a->warnings == b->warnings && a->nodes == b->nodes && a->count == b->count;
-}
-
 /* Do two builders hold the same build?  Queries, rim depth, and two
  * bundle rays gathered through every query. */
 static int same_build(const lp_backward *a, const lp_backward *b, double lambda_nm)
@@ -163,7 +139,7 @@ static int same_build(const lp_backward *a, const lp_backward *b, double lambda_
         if (sa != sb || !same_books(&ra, &rb))
             return 0;
         for (size_t k = 0; k < ra.count; k++)
-            if (!same_out(&ra.rays[k], &rb.rays[k]))
+            if (!same_out_ray(&ra.rays[k], &rb.rays[k]))
                 return 0;
     }
     return 1;

@@ -38,6 +38,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "same_bits.h"
 #include "lensprim.h"
 
 #define PI 3.14159265358979323846
@@ -108,32 +109,6 @@ static lp_ray record_of(const rays *r, size_t i, double lambda_nm)
     return x;
 }
 
-/* The same outgoing ray, compared field by field as bytes (no padding). */
-static int same_ray(const lp_out_ray *a, const lp_out_ray *b)
-{
-    const lp_ray *x = &a->ray, *y = &b->ray;
-    return memcmp(&x->origin, &y->origin, sizeof x->origin) == 0 &&
-           memcmp(&x->dir, &y->dir, sizeof x->dir) == 0 &&
-           memcmp(&x->lambda_nm, &y->lambda_nm, sizeof(double)) == 0 &&
-           memcmp(&x->intensity, &y->intensity, sizeof(double)) == 0 &&
-           memcmp(&x->vp, &y->vp, sizeof x->vp) == 0 && x->kphi == y->kphi &&
-           memcmp(&x->op, &y->op, sizeof(double)) == 0 &&
-           memcmp(&x->phase, &y->phase, sizeof(double)) == 0 && x->ch == y->ch &&
-           a->depth == b->depth && a->kind == b->kind && a->surface == b->surface &&
-           a->part == b->part && a->path == b->path && a->waves == b->waves;
-}
-
-static int same_books(const lp_result *a, const lp_result *b)
-{
-    return memcmp(&a->in, &b->in, sizeof(double)) == 0 &&
-           memcmp(&a->out, &b->out, sizeof(double)) == 0 &&
-           memcmp(&a->skipped, &b->skipped, sizeof(double)) == 0 &&
-           memcmp(&a->absorbed_glass, &b->absorbed_glass, sizeof(double)) == 0 &&
-           memcmp(&a->absorbed_rim, &b->absorbed_rim, sizeof(double)) == 0 &&
-           memcmp(&a->truncated, &b->truncated, sizeof(double)) == 0 &&
-           a->warnings == b->warnings && a->nodes == b->nodes && a->count == b->count;
-}
-
 static lp_vec3 place(lp_vec3 pos, lp_vec3 u, lp_vec3 v, lp_vec3 w, double x, double y,
                      double z)
 {
@@ -145,6 +120,30 @@ static int keep_odd_depths(const lp_branch_info *info, void *user)
 {
     (void)user;
     return info->depth % 2 == 1 || info->kind == LP_KIND_TRANSMIT;
+}
+
+/* The lens's outgoing rays (the first per_ray of every step-th ray of r
+ * traced at 550 nm) added to r: they start on its surface; back towards
+ * the lens half the time, onward the other half.  Returns how many. */
+static size_t feed_back(rays *r, const lp_lens *lens, size_t step, size_t per_ray)
+{
+    lp_result res;
+    lp_result_init(&res);
+    size_t base = r->n, added = 0;
+    for (size_t i = 0; i < base && r->n < MAX_RAYS; i += step) {
+        lp_ray x = record_of(r, i, 550.0);
+        if (lp_trace_forward(lens, &x, NULL, &res, NULL) != LP_OK)
+            continue;
+        for (size_t k = 0; k < res.count && k < per_ray && r->n < MAX_RAYS; k++) {
+            lp_vec3 d = res.rays[k].ray.dir;
+            if (k % 2 == 0)
+                d = vec(-d.x, -d.y, -d.z);
+            add_ray(r, res.rays[k].ray.origin, d, res.rays[k].ray.vp, res.rays[k].ray.intensity);
+            added++;
+        }
+    }
+    lp_result_release(&res);
+    return added;
 }
 
 /* Random rays at a lens with axis w at pos (u, v complete the frame). */
@@ -174,22 +173,7 @@ static void make_rays(rays *r, const lp_lens *lens, lp_vec3 pos, lp_vec3 u, lp_v
         add_ray(r, o, d, u, 1.0);
     }
     /* the lens's own outgoing rays, fed back: they start on its surface */
-    lp_result res;
-    lp_result_init(&res);
-    size_t base = r->n;
-    for (size_t i = 0; i < base && r->n < MAX_RAYS; i += 3) {
-        lp_ray x = record_of(r, i, 550.0);
-        if (lp_trace_forward(lens, &x, NULL, &res, NULL) != LP_OK)
-            continue;
-        for (size_t k = 0; k < res.count && r->n < MAX_RAYS; k++) {
-            lp_vec3 d = res.rays[k].ray.dir;
-            /* back towards the lens half the time, onward the other half */
-            if (k % 2 == 0)
-                d = vec(-d.x, -d.y, -d.z);
-            add_ray(r, res.rays[k].ray.origin, d, res.rays[k].ray.vp, res.rays[k].ray.intensity);
-        }
-    }
-    lp_result_release(&res);
+    feed_back(r, lens, 3, MAX_RAYS);
 }
 
 static int n_identity_cases;
@@ -227,7 +211,7 @@ static void identity_case(const char *name, const lp_lens *lens, const rays *r, 
               ra.in, rb.in);
         CHECK(memcmp(off_a, off_b, (n + 1) * sizeof *off_a) == 0, "%s: offsets", what);
         for (size_t k = 0; k < ra.count && k < rb.count; k++)
-            differ += !same_ray(&ra.rays[k], &rb.rays[k]);
+            differ += !same_out_ray(&ra.rays[k], &rb.rays[k]);
         CHECK(differ == 0, "%s: %zu of %zu outgoing rays differ from lp_trace_forward_many",
               what, differ, ra.count);
         /* and the one-ray entry point, ray by ray */
@@ -243,7 +227,7 @@ static void identity_case(const char *name, const lp_lens *lens, const rays *r, 
                 continue;
             }
             for (size_t k = 0; k < m; k++)
-                if (!same_ray(&ra.rays[off_a[i] + k], &one.rays[k])) {
+                if (!same_out_ray(&ra.rays[off_a[i] + k], &one.rays[k])) {
                     differ++;
                     break;
                 }
@@ -292,22 +276,7 @@ static void make_lane_rays(rays *r, const lp_lens *lens, lp_vec3 pos, lp_vec3 u,
         add_ray(r, o, d, v, 1.0);
     }
     /* the lens's own outgoing rays of depth 1 and 2, fed back */
-    lp_result res;
-    lp_result_init(&res);
-    size_t base = r->n;
-    for (size_t i = 0; i < base && r->n < MAX_RAYS; i += 7) {
-        lp_ray x = record_of(r, i, 550.0);
-        if (lp_trace_forward(lens, &x, NULL, &res, NULL) != LP_OK)
-            continue;
-        for (size_t k = 0; k < res.count && k < 2 && r->n < MAX_RAYS; k++) {
-            lp_vec3 d = res.rays[k].ray.dir;
-            if (k % 2 == 0)
-                d = vec(-d.x, -d.y, -d.z);
-            add_ray(r, res.rays[k].ray.origin, d, res.rays[k].ray.vp, res.rays[k].ray.intensity);
-            n_on_lens++;
-        }
-    }
-    lp_result_release(&res);
+    n_on_lens += feed_back(r, lens, 7, 2);
     /* shuffled (Fisher-Yates, on every array) */
     for (size_t i = r->n - 1; i > 0; i--) {
         size_t k = (size_t)(uniform() * (double)(i + 1));
@@ -591,7 +560,7 @@ static void test_errors(void)
           err.message);
     size_t differ = res.count != rb.count;
     for (size_t k = 0; k < res.count && k < rb.count; k++)
-        differ += !same_ray(&res.rays[k], &rb.rays[k]);
+        differ += !same_out_ray(&res.rays[k], &rb.rays[k]);
     CHECK(differ == 0 && same_books(&res, &rb), "NULL optional arrays: %zu rays differ", differ);
     lp_result_release(&res);
     lp_result_release(&rb);
@@ -657,7 +626,7 @@ static void test_runs(void)
                 }
                 in += one.in; /* the ray's intensity, or 0 when it misses */
                 for (size_t k = 0; k < one.count; k++) {
-                    differ += !same_ray(&res.rays[off[i] + k], &one.rays[k]);
+                    differ += !same_out_ray(&res.rays[off[i] + k], &one.rays[k]);
                     out += one.rays[k].ray.intensity;
                 }
                 rest[0] += one.skipped, rest[1] += one.absorbed_glass;
