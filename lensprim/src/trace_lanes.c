@@ -3,16 +3,18 @@
  *
  * The state of every lane is held as arrays (a structure of arrays), and
  * each step is a few loops over the lanes, free of branches and calls: a
- * lane's choices (which cap it meets, whether it has left) are selects,
- * and a lane that has left keeps computing numbers nobody reads (this
- * file is built with -fno-trapping-math for that).  The only calls are
- * expm1 (absorption) and the rim test of the lanes near the rim, in
- * plain loops between the vector ones.  Each formula below is the one of
- * the one-ray code (cap.h, rim.c, lens.c, interface.c, fresnel.h,
+ * lane's choices (which cap it meets, whether it has left, whether its
+ * field is real) are selects, and a lane that has left keeps computing
+ * numbers nobody reads (this file is built with -fno-trapping-math for
+ * that).  Between those loops, plain loops do lane by lane what the one-
+ * ray code does with calls: the rim test of the lanes near the rim,
+ * expm1 (absorption), and the nodes of total internal reflection or
+ * normal incidence (by the one-ray code's own node functions).  Each
+ * formula below is the one-ray code's (lanes.h, interface.c,
  * polarization.h, trace_common.c, trace_forward.c) with its operations in
  * the same order, so every lane's numbers are that code's, bit for bit;
- * only where a ray's branches could differ from the one-ray code's (the
- * cases trace_lanes.h lists) is the ray handed back.
+ * where a ray's branches could differ from the one-ray code's (the cases
+ * trace_lanes.h lists) the ray is handed back.
  *
  * The outgoing rays are kept per node and lane, and lp__lanes_emit adds
  * them to the result ray by ray in the one-ray code's order: sums of
@@ -138,8 +140,8 @@ typedef struct node_out {
     double flip;        /* 1: a phase jump on reflection */
 } node_out;
 
-LP__INLINE void node(int law, double n1, double n2, double eta, double r0, lp_vec3 d, lp_vec3 normal,
-                     lp_vec3 e, lp_vec3 f, node_out *o, int *odd)
+LP__INLINE void node(int law, double n1, double n2, double eta, double r0, lp_vec3 d,
+                     lp_vec3 normal, lp_vec3 e, lp_vec3 f, node_out *o, int *odd)
 {
     lp__lane_node g;
     lp__lane_node_at(n1, n2, eta, d, normal, &g);
@@ -232,8 +234,8 @@ LP__INLINE void stage(const consts *K, double (*f)[NL], size_t j, lp_vec3 x, lp_
 
 /* Node 1 of every ray taken: the entry hit (lp__lens_hit from outside
  * the lens), the external reflection, the refracted field. */
-LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__lane_in *in, size_t m,
-                     int law)
+LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__lane_in *in,
+                           size_t m, int law)
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
     for (size_t j = 0; j < m; j++) {
@@ -370,10 +372,11 @@ static void entry_rim(lp__lanes *restrict L, const consts *K, const lp__lane_in 
 }
 
 /* The second half of a step: the end of the lanes cut, the segment to
- * the hit (absorption, optical path), the rim, the node there (a real
- * field that meets no odd node): its outgoing ray into f, the reflected
- * field on.  odd[c] = 1 marks the lanes whose node odd_step does. */
-LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law, double (*restrict f)[NL])
+ * the hit (absorption, optical path), the rim, the node there: its
+ * outgoing ray into f, the reflected field on.  odd[c] = 1 marks the
+ * lanes whose node odd_step does instead. */
+LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law,
+                          double (*restrict f)[NL])
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
     size_t n = L->n_chain;
@@ -462,9 +465,9 @@ LP__WIDE static void node_kernel(lp__lanes *restrict L, const consts *K, int law
     }
 }
 
-/* The nodes odd_step left: the one-ray code's node (any field; total
- * internal reflection; normal incidence, where the field gives the s
- * axis). */
+/* The nodes node_step leaves to the one-ray code (odd[c] = 1): total
+ * internal reflection, and normal incidence, where the field gives the s
+ * axis; by its own node functions, lane by lane. */
 static void odd_step(lp__lanes *restrict L, const lp_lens *lens, const lp__optics *op,
                      lp_mode mode, double (*restrict f)[NL])
 {

@@ -6,12 +6,14 @@
  * one ray out and reflects the other on.  The rays of a group walk their
  * chains together, one node per step for all of them, in loops over the
  * lanes that the compiler vectorizes; a lane that leaves (a miss, the
- * rim, the depth, the weight cut) is masked off.  A lane that meets
- * anything rare -- total internal reflection, normal incidence, a start
- * on the lens, a chain that loses its way -- is handed back, and that
- * ray is traced from its start by the one-ray code.  Every operation is
- * the one-ray code's, in the same order, so a ray the engine traces gives
- * the same outgoing rays and sums, bit for bit. */
+ * rim, the depth, the weight cut) is masked off.  Fields made elliptical
+ * by total internal reflection go on in complex arithmetic; a node of
+ * total internal reflection or normal incidence is done for its lane by
+ * the one-ray code's node functions.  A ray that starts on the lens,
+ * meets such a node at its entry, or whose chain loses its way is handed
+ * back, and traced from its start by the one-ray code.  Every operation
+ * is the one-ray code's, in the same order, so a ray the engine traces
+ * gives the same outgoing rays and sums, bit for bit. */
 #ifndef LP_TRACE_LANES_H
 #define LP_TRACE_LANES_H
 
