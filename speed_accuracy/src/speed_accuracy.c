@@ -48,7 +48,9 @@ static const char *const usage_text[] = {
 "\n",
 "  --bin DIR        where lensrender and pov_compare are (default build/bin)\n"
 "  --work DIR       references and renders (default build/speed-accuracy)\n"
-"  --width W, --height H   image size of every render (default 16 x 12)\n"
+"  --width W, --height H   image size of every render (default 128 x 96:\n"
+"                   a process's fixed cost, 3 ms, is <= 25 % of the cheapest\n"
+"                   render's)\n"
 "  --runs K         timed runs per setting; its time is their median\n"
 "                   (default 3; a setting slower than 1 s runs once)\n"
 "  --scene NAME     only this scene (repeatable; default every *.scene)\n"
@@ -472,26 +474,30 @@ static int povray_point(const scene_ctx *sc, sa_point *p, rs_image *img)
 static const char *const MODELS[] = {"polarized", "fresnel", "schlick", "rgb"};
 static const int WAVELENGTHS[] = {4, 8, 16, 32, 64, 128, 256, 512};
 static const int DEPTHS[] = {4, 8, 16};
-/* 1e-6, not 0: without a cut-off a birefringent plate's tree doubles at
- * every bounce (see the reference); 1e-6 of the light is below every E. */
-static const double CUTOFFS[] = {1e-6, 1e-3, -1.0}; /* -1: the scene's adc_bailout */
+/* --mode auto's grid (renderer/src/auto_settings.c): cut-offs 1e-2 ...
+ * 1e-6 at every depth, 1e-8 ... 1e-12 (coherent scenes' floors) at the
+ * deepest; and the scene's own (-1: its adc_bailout), the default's. */
+static const double CUTOFFS[] = {1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12, -1.0};
 static const double TOLERANCES[] = {1e-2, 1e-3, 1e-4};
 
 #define N_OF(a) (sizeof(a) / sizeof *(a))
 
-/* Is the setting in the sweep?  Every model, depth and cut-off up to 64
- * wavelengths; beyond, the two models that can converge (polarized; and
- * fresnel, for scenes where it is exact enough) at depth 16 without
- * cut-off and at depth 8 with cut-off 1e-3; schlick at depth 16 without
- * cut-off; rgb has no wavelength count. */
+/* Is the setting in the sweep?  The grid auto chooses from, pruned where
+ * a setting cannot be on the front: cut-offs below 1e-6 and the scene's
+ * own only at depth 16 (auto uses them only there); from 64 wavelengths
+ * on, where the wavelength error is below 1e-3, only the trees whose own
+ * error can be too (depth 8 and 16, cut-off 1e-3 and below); rgb has no
+ * wavelength count. */
 static int in_sweep(int m, int wl, int d, int c)
 {
-    int full = WAVELENGTHS[wl] <= 32;
-    if (m == 3)
-        return wl == 0;
-    if (m == 2)
-        return DEPTHS[d] == 16 && c == 0;
-    return full || (DEPTHS[d] == 16 && c == 0) || (DEPTHS[d] == 8 && CUTOFFS[c] == 1e-3);
+    double cut = CUTOFFS[c];
+    if (m == 3 && wl != 0)
+        return 0;
+    if (cut < 1e-6 && DEPTHS[d] != 16)
+        return 0;
+    if (m != 3 && WAVELENGTHS[wl] >= 64 && (DEPTHS[d] < 8 || cut > 1e-3 || cut < 0.0))
+        return 0;
+    return 1;
 }
 
 /* ---- the runs, spread over the processes of the run -------------------
@@ -826,8 +832,8 @@ static int parse(opts *o, int argc, char **argv)
     o->scenes = "scenes";
     o->docs = "docs";
     o->work = "build/speed-accuracy";
-    o->width = 16;
-    o->height = 12;
+    o->width = 128;
+    o->height = 96;
     o->runs = 3;
     o->max_wavelengths = 16384;
     o->reference_seconds = 45.0;
