@@ -6,9 +6,9 @@
  * changes nothing, no branch cut-off).  Auto takes the candidate of least
  * cost whose error, estimated on a small probe of the image, is within E.
  * The candidates are the sweep's grid (speed_accuracy): every light model
- * the scene allows x wavelengths 4, 8, 16 ... 16384 x depth 4, 8 and 16
- * (or the scene's max_trace_level when larger) x cut-off 1e-2, 1e-3,
- * 1e-4, 1e-6, 1e-8 ... down to a floor.
+ * the scene allows x wavelengths 4, 8, 16 ... 16384 x depth 4, 8, 16 and
+ * 32 (or the scene's max_trace_level when larger) x cut-off 1e-2, 1e-3,
+ * 1e-4, 1e-6 and, from depth 16 on, 1e-8 ... 1e-12, down to a floor.
  *
  *   models      polarized only where the scene needs it: a polarizer, a
  *               crystal lens (its o and e rays part the light by

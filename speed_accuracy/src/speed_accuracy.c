@@ -473,27 +473,28 @@ static int povray_point(const scene_ctx *sc, sa_point *p, rs_image *img)
 
 static const char *const MODELS[] = {"polarized", "fresnel", "schlick", "rgb"};
 static const int WAVELENGTHS[] = {4, 8, 16, 32, 64, 128, 256, 512};
-static const int DEPTHS[] = {4, 8, 16};
+static const int DEPTHS[] = {4, 8, 16, 32};
 /* --mode auto's grid (renderer/src/auto_settings.c): cut-offs 1e-2 ...
- * 1e-6 at every depth, 1e-8 ... 1e-12 (coherent scenes' floors) at the
- * deepest; and the scene's own (-1: its adc_bailout), the default's. */
+ * 1e-6 at every depth, 1e-8 ... 1e-12 (coherent scenes' floors) from
+ * depth 16 on; and the scene's own (-1: its adc_bailout) at depth 16, the
+ * default's. */
 static const double CUTOFFS[] = {1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12, -1.0};
 static const double TOLERANCES[] = {1e-2, 1e-3, 1e-4};
 
 #define N_OF(a) (sizeof(a) / sizeof *(a))
 
 /* Is the setting in the sweep?  The grid auto chooses from, pruned where
- * a setting cannot be on the front: cut-offs below 1e-6 and the scene's
- * own only at depth 16 (auto uses them only there); from 64 wavelengths
- * on, where the wavelength error is below 1e-3, only the trees whose own
- * error can be too (depth 8 and 16, cut-off 1e-3 and below); rgb has no
- * wavelength count. */
+ * a setting cannot be on the front: cut-offs below 1e-6 only from depth
+ * 16 on (auto uses them only there), the scene's own only at depth 16;
+ * from 64 wavelengths on, where the wavelength error is below 1e-3, only
+ * the trees whose own error can be too (depth 8 and deeper, cut-off 1e-3
+ * and below); rgb has no wavelength count. */
 static int in_sweep(int m, int wl, int d, int c)
 {
     double cut = CUTOFFS[c];
     if (m == 3 && wl != 0)
         return 0;
-    if (cut < 1e-6 && DEPTHS[d] != 16)
+    if ((cut < 0.0 && DEPTHS[d] != 16) || (cut >= 0.0 && cut < 1e-6 && DEPTHS[d] < 16))
         return 0;
     if (m != 3 && WAVELENGTHS[wl] >= 64 && (DEPTHS[d] < 8 || cut > 1e-3 || cut < 0.0))
         return 0;
