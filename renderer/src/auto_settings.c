@@ -506,7 +506,6 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     int rung_n[RUNGS_MAX];
     double e_top = INFINITY, e_model[4] = {0, 0, 0, 0}, mcost[4] = {1, 1, 1, 1};
     double rung_spent = 0.0;
-    size_t n_probe;
     int depths[4], n_depths = 0, depth_max;
     rs_render_opts o;
     choice best = {RS_MODE_POLARIZED, 0, 0, 0, INFINITY, 0, 0, 0, -1.0};
@@ -563,17 +562,20 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         if (probe_pick(scene, &pilot, pol_reason != NULL, &ps, &spent, msg, msg_size) != 0)
             return -1;
     }
-    n_probe = ps.n[G_MARKED] + ps.n[G_LENS] + ps.n[G_OTHER];
 
-    /* Every tree in the ladder's model at the first rung; e_tree against T*. */
+    /* Every tree, in rgb (cheap, and each an rgb candidate) or, where the
+     * scene needs it, polarized at the first rung; e_tree against T*. */
     o.mode = L;
     o.wavelengths = req->wavelengths > 0 ? req->wavelengths : N_FIRST;
     for (int t = 0; t < n_trees; t++) {
         rs_render_opts f = o;
+        f.mode = pol_reason ? RS_MODE_POLARIZED : RS_MODE_RGB;
         f.depth = tr[t].depth;
         f.cutoff = tr[t].cutoff;
         if (probe(scene, &f, &ps, &tr[t].s, &spent, msg, msg_size) != 0)
             goto done;
+        if (!pol_reason)
+            rgb[t] = tr[t].s; /* not owned */
     }
     for (int t = 0; t < n_trees; t++)
         tr[t].e = rms_diff(&ps, tr[t].s.c, tr[t_star].s.c) + e_star;
@@ -583,32 +585,25 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         if (tr[t].e <= TREE_LADDER * E && tr[t].s.cost < tr[t_lad].s.cost)
             t_lad = t;
 
-    /* The models at the first rung and the ladder's tree: their departure
-     * from polarized and their cost relative to L; rgb at every tree
-     * whose own error is within E (the others cannot meet it). */
-    if (!pol_reason) {
+    /* The ladder's first rung, and the models there: their departure from
+     * polarized and their cost relative to L. */
+    {
         rs_render_opts f = o;
         f.depth = tr[t_lad].depth;
         f.cutoff = tr[t_lad].cutoff;
-        f.mode = RS_MODE_POLARIZED;
-        if (probe(scene, &f, &ps, &pol, &spent, msg, msg_size) != 0)
+        if (probe(scene, &f, &ps, &rung[0], &spent, msg, msg_size) != 0)
             goto done;
-        f.mode = RS_MODE_SCHLICK;
-        if (probe(scene, &f, &ps, &sch, &spent, msg, msg_size) != 0)
-            goto done;
-        e_model[RS_MODE_FRESNEL] = rms_diff(&ps, tr[t_lad].s.c, pol.c);
-        e_model[RS_MODE_SCHLICK] = rms_diff(&ps, sch.c, pol.c);
-        mcost[RS_MODE_POLARIZED] = pol.cost / tr[t_lad].s.cost;
-        mcost[RS_MODE_SCHLICK] = sch.cost / tr[t_lad].s.cost;
-        for (int t = 0; t < n_trees; t++) {
-            rs_render_opts g = o;
-            if (tr[t].e > E)
-                continue;
-            g.mode = RS_MODE_RGB;
-            g.depth = tr[t].depth;
-            g.cutoff = tr[t].cutoff;
-            if (probe(scene, &g, &ps, &rgb[t], &spent, msg, msg_size) != 0)
+        if (!pol_reason) {
+            f.mode = RS_MODE_POLARIZED;
+            if (probe(scene, &f, &ps, &pol, &spent, msg, msg_size) != 0)
                 goto done;
+            f.mode = RS_MODE_SCHLICK;
+            if (probe(scene, &f, &ps, &sch, &spent, msg, msg_size) != 0)
+                goto done;
+            e_model[RS_MODE_FRESNEL] = rms_diff(&ps, rung[0].c, pol.c);
+            e_model[RS_MODE_SCHLICK] = rms_diff(&ps, sch.c, pol.c);
+            mcost[RS_MODE_POLARIZED] = pol.cost / rung[0].cost;
+            mcost[RS_MODE_SCHLICK] = sch.cost / rung[0].cost;
         }
     }
 
@@ -617,13 +612,6 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
      * TOP_SHARE E, or once some candidate meets E, until the next rung
      * would cost the probe more than CLIMB_SHARE of that candidate's
      * render (a rung's estimate can only halve the wavelengths). */
-    rung[0] = tr[t_lad].s;
-    rung[0].c = malloc(sizeof *rung[0].c * (n_probe + 1));
-    if (!rung[0].c) {
-        snprintf(msg, msg_size, "out of memory");
-        goto done;
-    }
-    memcpy(rung[0].c, tr[t_lad].s.c, sizeof *rung[0].c * n_probe);
     rung_n[0] = o.wavelengths;
     n_rungs = 1;
     for (;;) {
@@ -703,7 +691,6 @@ done:
     free(ps.px);
     for (int t = 0; t < n_trees; t++) {
         free(tr[t].s.c);
-        free(rgb[t].c);
     }
     for (int k = 0; k < RUNGS_MAX; k++)
         free(rung[k].c);
