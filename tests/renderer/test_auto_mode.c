@@ -173,6 +173,21 @@ static int unresolved_at_1e3(const char *name)
     return 0;
 }
 
+/* A reference's options: polarized, width x height, the depth, cut-off
+ * and wavelengths given. */
+static rs_render_opts polarized_opts(int width, int height, int depth, double cutoff, int n)
+{
+    rs_render_opts o;
+    rs_render_opts_init(&o);
+    o.mode = RS_MODE_POLARIZED;
+    o.width = width;
+    o.height = height;
+    o.depth = depth;
+    o.cutoff = cutoff;
+    o.wavelengths = n;
+    return o;
+}
+
 /* Does some lens's glass change its index over the visible (400 nm
  * against 700 nm)? */
 static int dispersive(const rs_scene *sc)
@@ -202,13 +217,7 @@ static void at_chart_size(const rs_scene *sc, const char *name)
         free(img);
         return;
     }
-    rs_render_opts_init(&o);
-    o.mode = RS_MODE_POLARIZED;
-    o.width = CHART_W;
-    o.height = CHART_H;
-    o.depth = REF_DEPTH;
-    o.cutoff = REF_CUTOFF;
-    o.wavelengths = REF_N;
+    o = polarized_opts(CHART_W, CHART_H, REF_DEPTH, REF_CUTOFF, REF_N);
     rs_render_opts_init(&def);
     def.mode = RS_MODE_POLARIZED;
     def.width = CHART_W;
@@ -275,13 +284,7 @@ static void one_scene(const shipped_scene *ss)
         rs_scene_free(&sc);
         return;
     }
-    rs_render_opts_init(&o);
-    o.mode = RS_MODE_POLARIZED;
-    o.width = W;
-    o.height = H;
-    o.depth = ref_depth;
-    o.cutoff = ss->ref_cutoff > 0.0 ? ss->ref_cutoff : REF_CUTOFF;
-    o.wavelengths = ref_n;
+    o = polarized_opts(W, H, ref_depth, ss->ref_cutoff > 0.0 ? ss->ref_cutoff : REF_CUTOFF, ref_n);
     CHECK(render(&sc, &o, ref, NULL) == 0, "%s: reference renders", name);
     o.wavelengths = ref_n / 2;
     CHECK(render(&sc, &o, ref2, NULL) == 0, "%s: half reference renders", name);
