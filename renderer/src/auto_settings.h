@@ -54,7 +54,7 @@
  * 1/256 of the image (at least 192 pixels: every pixel of a small image),
  * in rgb, or polarized at one wavelength where the scene needs that model
  * -- marks the brightest and (rgb) the most saturated pixels, 6 of each or
- * one in 64 of the pilot's, each standing for itself: a regular
+ * one in 64 of the pilot's, each standing for its cell: a regular
  * subsample misses the few pixels that carry most of an error (a
  * cut-off's dropped branch under a bright highlight, a wavelength count's
  * error on a saturated colour).  The marked pixels are in every probe
