@@ -37,7 +37,7 @@ static const char *const usage_text[] = {
 "usage: speed_accuracy [--bin DIR] [--scenes DIR] [--docs DIR] [--work DIR]\n"
 "                      [--width W] [--height H] [--runs K] [--scene NAME]...\n"
 "                      [--max-wavelengths N] [--reference-seconds S]\n"
-"                      [--point-seconds S] [--reuse-references]\n"
+"                      [--point-seconds S] [--auto-seconds S] [--reuse-references]\n"
 "       speed_accuracy --chart-only [--docs DIR]\n"
 "       speed_accuracy --help\n"
 "\n"
@@ -59,6 +59,8 @@ static const char *const usage_text[] = {
 "                   render) to take longer than S CPU seconds (default 45)\n"
 "  --point-seconds S   no swept setting predicted (from the reference's time\n"
 "                   per wavelength) to take longer than S (default 10)\n"
+"  --auto-seconds S    an auto render (its probe included) that takes more\n"
+"                   CPU time is left out (default 300)\n"
 "  --reuse-references    keep references already in the work directory\n"
 "  --references-only     make the references and stop\n"
 "\n"
@@ -82,6 +84,7 @@ typedef struct opts {
     int width, height, runs, max_wavelengths, reuse, chart_only, references_only;
     double reference_seconds; /* a reference doubling predicted slower is not run */
     double point_seconds;     /* a swept setting predicted slower is not run */
+    double auto_seconds;      /* an auto point that runs longer is left out */
     int rank; /* this process's, in a run across processes (names its renders) */
     const char *only[64];
     int n_only;
@@ -674,9 +677,13 @@ static int point_run(void *user, long k, void *result, size_t *used, char *msg,
     } else {
         /* A swept point that runs out of 4 x --point-seconds is left out (no
          * image): the time predicted from the cheap render does not know
-         * a scene's own cut-off of 0 on a birefringent tree. */
-        rc = render(&w->sc[jp->scene], &h.p, w->o->runs,
-                    strcmp(h.p.kind, "sweep") == 0 ? 4.0 * w->o->point_seconds : 0.0, &img);
+         * a scene's own cut-off of 0 on a birefringent tree.  An auto
+         * point that runs out of --auto-seconds too (thousands of
+         * wavelengths through dispersive glass at E = 1e-4). */
+        double limit = strcmp(h.p.kind, "sweep") == 0  ? 4.0 * w->o->point_seconds
+                       : strcmp(h.p.kind, "auto") == 0 ? w->o->auto_seconds
+                                                       : 0.0;
+        rc = render(&w->sc[jp->scene], &h.p, w->o->runs, limit, &img);
         if (rc == 1) {
             memset(&h.p.err, 0, sizeof h.p.err);
             rc = 0;
@@ -839,6 +846,7 @@ static int parse(opts *o, int argc, char **argv)
     o->max_wavelengths = 16384;
     o->reference_seconds = 45.0;
     o->point_seconds = 10.0;
+    o->auto_seconds = 300.0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -863,14 +871,16 @@ static int parse(opts *o, int argc, char **argv)
             o->docs = v, i++;
         } else if (strcmp(a, "--work") == 0) {
             o->work = v, i++;
-        } else if (strcmp(a, "--reference-seconds") == 0 || strcmp(a, "--point-seconds") == 0) {
+        } else if (strcmp(a, "--reference-seconds") == 0 || strcmp(a, "--point-seconds") == 0 ||
+                   strcmp(a, "--auto-seconds") == 0) {
             char *end;
             double x = strtod(v, &end);
             if (end == v || *end || !(x > 0.0 && x <= 1e6)) {
                 say("%s: '%s' is out of range", a, v);
                 return -1;
             }
-            *(a[2] == 'r' ? &o->reference_seconds : &o->point_seconds) = x;
+            *(a[2] == 'r' ? &o->reference_seconds
+              : a[2] == 'p' ? &o->point_seconds : &o->auto_seconds) = x;
             i++;
         } else if (strcmp(a, "--scene") == 0) {
             if (o->n_only == (int)N_OF(o->only)) {
