@@ -215,6 +215,32 @@ static void mark_top(scored *sc, size_t n, size_t want, unsigned char *mark)
             mark[sc[m].k] = 1;
 }
 
+/* A fixed scramble of a pixel's index (splitmix64's finalizer). */
+static uint64_t mix(uint64_t x)
+{
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+/* The pixel that stands for pilot cell m (nx cells a row, step x step
+ * pixels each): a scrambled one of the cell, not its middle, which the
+ * pilot chose for being extreme -- a pixel picked at random from the
+ * cell weighs the cell without bias (mirror_ball at 128 x 96, E = 1e-4:
+ * the middle standing only for itself under-counted its coloured rings,
+ * 9.1e-5 against 1.4e-4 rendered; standing for the cell, it tripled the
+ * error of crossed_polarizers' dispersed edges). */
+static long cell_pixel(size_t m, int nx, int step, int width, int height)
+{
+    uint64_t r = mix((uint64_t)m);
+    int i = (int)(m % (size_t)nx) * step + (int)(r % (uint64_t)step);
+    int j = (int)(m / (size_t)nx) * step + (int)((r >> 32) % (uint64_t)step);
+    i = i < width ? i : width - 1;
+    j = j < height ? j : height - 1;
+    return (long)j * width + i;
+}
+
 /* The pilot (see probe_set): the middle pixel of every step x step cell
  * of the image, rendered with base in rgb -- brightness and saturation
  * at the cost of one lane -- or, where the scene needs the polarized
@@ -255,7 +281,7 @@ static int pilot_mark(const rs_scene *s, const rs_render_opts *base, int polariz
         for (size_t m = 0; m < n; m++) {
             double hi = cmax(c[m]), lo = fmin(c[m].r, fmin(c[m].g, c[m].b));
             sc[m].v = pass == 0 ? hi : hi - lo;
-            sc[m].k = (long)px[2 * m + 1] * width + px[2 * m];
+            sc[m].k = cell_pixel(m, nx, step, width, height);
             if (!(sc[m].v == sc[m].v))
                 sc[m].v = 0.0;
         }
@@ -267,15 +293,6 @@ out:
     free(c);
     free(sc);
     return rc;
-}
-
-/* A fixed scramble of a pixel's index (splitmix64's finalizer). */
-static uint64_t mix(uint64_t x)
-{
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
 }
 
 static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polarized,
@@ -316,11 +333,8 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
             count[g]++;
             ps->lens_share += lens ? 1.0 / (double)total : 0.0;
         }
-    /* A marked pixel stands for its pilot cell (at most what there is);
-     * the other groups share the rest in proportion.  Not for itself
-     * alone: mirror_ball at 128 x 96, E = 1e-4, then under-counted the
-     * error of 32 wavelengths on its coloured rings (estimate 9.1e-5, the
-     * render 1.4e-4 off). */
+    /* A marked pixel (cell_pixel) stands for its pilot cell (at most what
+     * there is); the other groups share the rest in proportion. */
     {
         double marked = fmin(1.0, (double)count[G_MARKED] * step * step / (double)total);
         long rest = count[G_LENS] + count[G_OTHER];

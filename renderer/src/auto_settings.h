@@ -53,12 +53,13 @@
  * The probe: a pilot first -- one pixel in every cell of a grid of about
  * 1/256 of the image (at least 192 pixels: every pixel of a small image),
  * in rgb, or polarized at one wavelength where the scene needs that model
- * -- marks the brightest and (rgb) the most saturated pixels, 6 of each or
- * one in 64 of the pilot's, each standing for its cell: a regular
- * subsample misses the few pixels that carry most of an error (a
- * cut-off's dropped branch under a bright highlight, a wavelength count's
- * error on a saturated colour).  The marked pixels are in every probe
- * render; then one in 16 of the other pixels whose camera ray meets a
+ * -- marks the cells of the brightest and (rgb) the most saturated
+ * pixels, 6 of each or one in 64 of the pilot's, each cell standing in the
+ * probe by a scrambled pixel of its own: a regular subsample misses the
+ * few pixels that carry most of an error (a cut-off's dropped branch
+ * under a bright highlight, a wavelength count's error on a saturated
+ * colour), and the pilot's extreme pixel itself would weigh its cell high.
+ * The marked pixels are in every probe render; then one in 16 of the other pixels whose camera ray meets a
  * lens (through polarizers, which are thin sheets) and one in 128 of the
  * rest (at least 24 and 8, lens pixels at most one in 64 of the image),
  * each group weighted by its share of the image; a subsampled group's
