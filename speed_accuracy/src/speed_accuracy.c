@@ -36,7 +36,8 @@
 static const char *const usage_text[] = {
 "usage: speed_accuracy [--bin DIR] [--scenes DIR] [--docs DIR] [--work DIR]\n"
 "                      [--width W] [--height H] [--runs K] [--scene NAME]...\n"
-"                      [--max-wavelengths N] [--reference-seconds S]\n"
+"                      [--max-wavelengths N] [--sweep-wavelengths N]\n"
+"                      [--reference-seconds S]\n"
 "                      [--point-seconds S] [--auto-seconds S] [--reuse-references]\n"
 "       speed_accuracy --chart-only [--docs DIR]\n"
 "       speed_accuracy --help\n"
@@ -55,6 +56,8 @@ static const char *const usage_text[] = {
 "                   (default 3; a setting slower than 1 s runs once)\n"
 "  --scene NAME     only this scene (repeatable; default every *.scene)\n"
 "  --max-wavelengths N   the reference's wavelength cap, <= 16384 (default 16384)\n"
+"  --sweep-wavelengths N   the swept settings' largest wavelength count\n"
+"                   (default 512)\n"
 "  --reference-seconds S   no reference doubling predicted (2.5 x the last\n"
 "                   render) to take longer than S CPU seconds (default 45)\n"
 "  --point-seconds S   no swept setting predicted (from the reference's time\n"
@@ -82,6 +85,7 @@ static const char *const usage_text[] = {
 typedef struct opts {
     const char *bin, *scenes, *docs, *work;
     int width, height, runs, max_wavelengths, reuse, chart_only, references_only;
+    int sweep_wavelengths; /* the sweep's largest wavelength count */
     double reference_seconds; /* a reference doubling predicted slower is not run */
     double point_seconds;     /* a swept setting predicted slower is not run */
     double auto_seconds;      /* an auto point that runs longer is left out */
@@ -576,7 +580,8 @@ static int list_points(sweep *w, int k)
                         continue;
                     /* Predicted from the reference's time per wavelength
                      * (deeper, a lower cut-off, polarized: an upper bound). */
-                    if (m != 3 && WAVELENGTHS[wl] * w->sc[k].rn.s_per_wl > w->o->point_seconds)
+                    if (m != 3 && (WAVELENGTHS[wl] * w->sc[k].rn.s_per_wl > w->o->point_seconds ||
+                                   WAVELENGTHS[wl] > w->o->sweep_wavelengths))
                         continue;
                     sa_point_init(&p, "sweep", MODELS[m], m == 3 ? 0 : WAVELENGTHS[wl],
                                   DEPTHS[d], CUTOFFS[c]);
@@ -844,6 +849,7 @@ static int parse(opts *o, int argc, char **argv)
     o->height = 96;
     o->runs = 3;
     o->max_wavelengths = 16384;
+    o->sweep_wavelengths = 512;
     o->reference_seconds = 45.0;
     o->point_seconds = 10.0;
     o->auto_seconds = 300.0;
@@ -889,9 +895,11 @@ static int parse(opts *o, int argc, char **argv)
             }
             o->only[o->n_only++] = v, i++;
         } else if (strcmp(a, "--width") == 0 || strcmp(a, "--height") == 0 ||
-                   strcmp(a, "--runs") == 0 || strcmp(a, "--max-wavelengths") == 0) {
+                   strcmp(a, "--runs") == 0 || strcmp(a, "--max-wavelengths") == 0 ||
+                   strcmp(a, "--sweep-wavelengths") == 0) {
             int *dst = a[2] == 'w' ? &o->width : a[2] == 'h' ? &o->height
-                       : a[2] == 'r' ? &o->runs : &o->max_wavelengths;
+                       : a[2] == 'r' ? &o->runs : a[2] == 'm' ? &o->max_wavelengths
+                                                 : &o->sweep_wavelengths;
             if (int_arg(v, 1, a[2] == 'r' ? 15 : 16384, dst) != 0) {
                 say("%s: '%s' is out of range", a, v);
                 return -1;
