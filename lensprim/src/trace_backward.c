@@ -16,36 +16,9 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "backward.h"
 #include "error.h"
 #include "interface.h"
-#include "trace.h"
-#include "trace_crystal.h"
-
-typedef struct bw_node {
-    lp_vec3 p;       /* local point */
-    lp_vec3 n;       /* outward normal */
-    lp_vec3 e_out;   /* eye direction inside the glass leaving this node */
-    double seg;      /* length from this node to the next one */
-    double seg_att;  /* amplitude factor over seg: exp(-alpha seg / 2) */
-    double seg_abs;  /* power fraction absorbed over seg: 1 - seg_att^2 */
-    int surface;
-} bw_node;
-
-struct lp_backward {
-    const lp_lens *lens;
-    lp_trace_args args;
-    lp__optics optics;
-    lp_vec3 view_dir;              /* local e_0 */
-    int n_nodes;
-    bw_node node[LP_MAX_DEPTH + 1]; /* node[1..n_nodes] */
-    size_t n_queries;
-    lp_query query[LP_MAX_DEPTH];
-    lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
-    lp__exit exit;                   /* where gathered light leaves */
-    int rim_depth;
-    unsigned warnings;
-    lp__xback *xb;                 /* the last build's, through a crystal */
-};
 
 lp_status lp_backward_create(lp_backward **out, lp_error *err)
 {
@@ -120,18 +93,25 @@ static void light_node(const lp_backward *bw, int j, lp__node *nd)
                    bw->optics.n_medium, NULL);
 }
 
-static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
-                      uint64_t path, double op, double bound, double weight)
+void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
+                            uint64_t path, double op, double bound, double weight)
+{
+    lp__backward_add_query_at(bw, depth, kind, surface, dir,
+                              lp__to_world_point(bw->lens, bw->node[depth].p),
+                              lp__to_world_dir(bw->lens, dir), path, op, bound, weight);
+}
+
+void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
+                               lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
+                               uint64_t path, double op, double bound, double weight)
 {
     lp_query *q = &bw->query[bw->n_queries];
-    lp_branch_info info;
+    lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
 
-    if (bound < bw->args.min_weight ||
-        !lp__branch_keep(bw->lens, &bw->args, depth, kind, surface, bw->node[depth].p, dir,
-                         bound, &info))
+    if (bound < bw->args.min_weight || !lp__args_keep(&bw->args, &info))
         return;
-    q->origin = info.origin;
-    q->dir = info.dir;
+    q->origin = world_origin;
+    q->dir = world_dir;
     q->depth = depth;
     q->kind = kind;
     q->surface = surface;
@@ -192,22 +172,19 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     bw->node[1].p = h.p;
     bw->node[1].n = h.n;
     bw->node[1].surface = h.surface;
-    int tir = lp__node_setup(&nd, d, h.n, o->n_medium, o->n_glass, NULL);
-    lp__branch br;
-    lp__cvec3 zero = {0, 0, 0};
-    lp__node_reflect(&nd, mode, &zero, &br);
-    add_query(bw, 1, LP_KIND_REFLECT, h.surface, br.dir, 1u, 0.0, node_bound(&nd, mode, 1),
-              node_weight(&nd, mode, 1));
+    /* the branches' directions and powers (no fields) */
+    int tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_medium, o->n_glass);
+    lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, lp__node_reflect_dir(&nd), 1u, 0.0,
+                           node_bound(&nd, mode, 1), node_weight(&nd, mode, 1));
     if (tir) {
         lp__ok(err);
         return LP_OK;
     }
 
-    lp__node_transmit(&nd, mode, &zero, &br);
     double bound = node_bound(&nd, mode, 0), weight = node_weight(&nd, mode, 0), op = 0.0;
     uint64_t path = 0;
     int depth = 1;
-    d = br.dir;
+    d = lp__node_transmit_dir(&nd);
     p = h.p;
     int surface = h.surface;
     bw->node[1].e_out = d;
@@ -234,18 +211,17 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
         bw->node[depth].p = h.p;
         bw->node[depth].n = h.n;
         bw->node[depth].surface = h.surface;
-        tir = lp__node_setup(&nd, d, h.n, o->n_glass, o->n_medium, NULL);
-        if (!tir) {
-            lp__node_transmit(&nd, mode, &zero, &br);
-            add_query(bw, depth, h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
-                      h.surface, br.dir, path, op, bound * node_bound(&nd, mode, 0),
-                      weight * node_weight(&nd, mode, 0));
-        }
-        lp__node_reflect(&nd, mode, &zero, &br);
+        tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_glass, o->n_medium);
+        if (!tir)
+            lp__backward_add_query(bw, depth,
+                                   h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
+                                   h.surface, lp__node_transmit_dir(&nd), path, op,
+                                   bound * node_bound(&nd, mode, 0),
+                                   weight * node_weight(&nd, mode, 0));
         bound *= node_bound(&nd, mode, 1);
         weight *= node_weight(&nd, mode, 1);
         path |= (uint64_t)1 << (depth - 1);
-        d = br.dir;
+        d = lp__node_reflect_dir(&nd);
         p = h.p;
         surface = h.surface;
         bw->node[depth].e_out = d;
