@@ -5,6 +5,7 @@
 #include "args.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,29 +13,26 @@
 #include "camera.h"
 #include "shapes.h"
 
-#define SHARE_MODEL 0.5   /* of E: fresnel's departure from polarized */
 #define SHARE_CUTOFF 0.1  /* of E: the radiance one dropped branch may carry */
-#define SHARE_TREE 0.2    /* of E: what the cut-off drops, measured */
-#define CUT_FIRST 0.01    /* the cut-off ladder's first rung */
-#define CUT_STEP 0.1      /* and its step */
-#define DEPTH_MIN 16      /* the depth, unless the scene asks for more */
-#define SAFETY 2.0        /* error of N <= SAFETY x the change from N to 2N */
+#define TOP_SHARE 0.125   /* of E: the ladder's top rung's error, at most */
+#define TREE_LADDER 0.25  /* of E: the ladder's tree's error, at most */
+#define CLIMB_SHARE 0.05  /* of the best render's cost: a rung the probe may add */
+#define DEPTH_MIN 32      /* the deepest tree, unless the scene asks for more */
+#define DEEP_CUT_DEPTH 16 /* cut-offs below 1e-6 only at this depth and deeper */
 #define N_FIRST 4         /* the ladder's first rung */
 #define PROBE_LENS 24     /* probe pixels seeing a lens, at least */
 #define PROBE_OTHER 8     /* and the others */
-#define EVERY_LENS 4      /* or one in this many of the lens group */
-#define EVERY_OTHER 32    /* and of the others */
+#define EVERY_LENS 32     /* or one in this many of the lens group */
+#define EVERY_OTHER 256   /* and of the others */
 #define PROBE_MAX 1024    /* but at most this many of each group */
-#define LENS_SHARE_MAX 16 /* and lens pixels at most one in this many of all */
+#define LENS_SHARE_MAX 128 /* and lens pixels at most one in this many of all */
 #define WAVELENGTHS_MAX RS_ARGS_WAVELENGTHS_MAX /* what lensrender takes */
-#define PILOT_STEP 2      /* the pilot renders one pixel of each 2 x 2 cell */
-#define PILOT_MAX 4096    /* and at most this many (larger cells beyond) */
+#define RUNGS_MAX 16      /* 4 .. 16384 wavelengths, doubling */
+#define PILOT_EVERY 256   /* the pilot renders about one pixel in this many */
 #define PILOT_MIN 192     /* but at least this many: every pixel of a small image */
 #define MARK_MIN 6        /* marked pixels of each kind, at least */
 #define MARK_EVERY 64     /* or one in this many of the pilot's */
 #define MARK_MAX 256      /* but at most this many */
-#define P_MIN 0.5         /* the extrapolation's exponent, clamped */
-#define P_MAX 2.0
 #define LAMBDA_BLUE 400.0 /* the span over which dispersion is reported */
 #define LAMBDA_RED 700.0
 
@@ -162,13 +160,17 @@ static int sees_lens(const rs_scene *s, lp_vec3 o, lp_vec3 d)
     return 0;
 }
 
-/* Render the n pixels px[2k], px[2k + 1] with opts into out[0..n); count
- * the wavelength samples in *samples. */
+/* Render the pixels px[2k], px[2k + 1] of the groups of sizes n[0..ng)
+ * (one after another) with opts into out; the cost of each group's
+ * renders (rs_work_cost) into gcost[g] and their sum added to *spent. */
 static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const int *px,
-                         size_t n, rs_color *out, double *samples, char *msg, size_t msg_size)
+                         const size_t *n, int ng, rs_color *out, double *gcost, double *spent,
+                         char *msg, size_t msg_size)
 {
     rs_integrator *it;
     rs_worker *w;
+    rs_work before = {0, 0, 0, 0}, after;
+    size_t k = 0;
     if (rs_integrator_create(s, opts, &it, msg, msg_size) != 0)
         return -1;
     w = rs_worker_create(it);
@@ -177,11 +179,18 @@ static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const in
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
-    for (size_t k = 0; k < n; k++)
-        rs_integrator_pixel(it, w, px[2 * k], px[2 * k + 1], &out[k]);
+    for (int g = 0; g < ng; g++) {
+        for (size_t m = 0; m < n[g]; m++, k++)
+            rs_integrator_pixel(it, w, px[2 * k], px[2 * k + 1], &out[k]);
+        rs_worker_work(w, &after);
+        rs_work d = {after.rays - before.rays, after.lane_rays - before.lane_rays,
+                     after.builds - before.builds, after.gathered - before.gathered};
+        gcost[g] = rs_work_cost(&d, opts->mode, (double)n[g]);
+        *spent += gcost[g];
+        before = after;
+    }
     rs_worker_destroy(w);
     rs_integrator_destroy(it);
-    *samples += (double)n * (opts->mode == RS_MODE_RGB ? 1 : opts->wavelengths);
     return 0;
 }
 
@@ -206,6 +215,32 @@ static void mark_top(scored *sc, size_t n, size_t want, unsigned char *mark)
             mark[sc[m].k] = 1;
 }
 
+/* A fixed scramble of a pixel's index (splitmix64's finalizer). */
+static uint64_t mix(uint64_t x)
+{
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
+/* The pixel that stands for pilot cell m (nx cells a row, step x step
+ * pixels each): a scrambled one of the cell, not its middle, which the
+ * pilot chose for being extreme -- a pixel picked at random from the
+ * cell weighs the cell without bias (mirror_ball at 128 x 96, E = 1e-4:
+ * the middle standing only for itself under-counted its coloured rings,
+ * 9.1e-5 against 1.4e-4 rendered; standing for the cell, it tripled the
+ * error of crossed_polarizers' dispersed edges). */
+static long cell_pixel(size_t m, int nx, int step, int width, int height)
+{
+    uint64_t r = mix((uint64_t)m);
+    int i = (int)(m % (size_t)nx) * step + (int)(r % (uint64_t)step);
+    int j = (int)(m / (size_t)nx) * step + (int)((r >> 32) % (uint64_t)step);
+    i = i < width ? i : width - 1;
+    j = j < height ? j : height - 1;
+    return (long)j * width + i;
+}
+
 /* The pilot (see probe_set): the middle pixel of every step x step cell
  * of the image, rendered with base in rgb -- brightness and saturation
  * at the cost of one lane -- or, where the scene needs the polarized
@@ -213,7 +248,7 @@ static void mark_top(scored *sc, size_t n, size_t want, unsigned char *mark)
  * wavelength: brightness only.  The brightest and the most saturated are
  * marked in mark[] (by pixel); each stands for its cell. */
 static int pilot_mark(const rs_scene *s, const rs_render_opts *base, int polarized, int step,
-                      unsigned char *mark, double *samples, char *msg, size_t msg_size)
+                      unsigned char *mark, double *spent, char *msg, size_t msg_size)
 {
     int width = base->width, height = base->height;
     int nx = (width + step - 1) / step, ny = (height + step - 1) / step;
@@ -237,13 +272,16 @@ static int pilot_mark(const rs_scene *s, const rs_render_opts *base, int polariz
     want = want < MARK_MAX ? want : MARK_MAX;
     f.mode = polarized ? RS_MODE_POLARIZED : RS_MODE_RGB;
     f.wavelengths = 1;
-    if (render_pixels(s, &f, px, n, c, samples, msg, msg_size) != 0)
-        goto out;
+    {
+        double gc;
+        if (render_pixels(s, &f, px, &n, 1, c, &gc, spent, msg, msg_size) != 0)
+            goto out;
+    }
     for (int pass = 0; pass < (polarized ? 1 : 2); pass++) {
         for (size_t m = 0; m < n; m++) {
             double hi = cmax(c[m]), lo = fmin(c[m].r, fmin(c[m].g, c[m].b));
             sc[m].v = pass == 0 ? hi : hi - lo;
-            sc[m].k = (long)px[2 * m + 1] * width + px[2 * m];
+            sc[m].k = cell_pixel(m, nx, step, width, height);
             if (!(sc[m].v == sc[m].v))
                 sc[m].v = 0.0;
         }
@@ -258,17 +296,17 @@ out:
 }
 
 static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polarized,
-                      probe_set *ps, double *samples, char *msg, size_t msg_size)
+                      probe_set *ps, double *spent, char *msg, size_t msg_size)
 {
     rs_view view;
     int width = base->width, height = base->height;
     long count[N_GROUPS] = {0, 0, 0}, total = (long)width * height;
     long every[N_GROUPS];
-    int step = PILOT_STEP;
-    while ((long)((width + step - 1) / step) * ((height + step - 1) / step) > PILOT_MAX)
+    /* the largest cells that still give the pilot its pixels */
+    long pilot_want = total / PILOT_EVERY > PILOT_MIN ? total / PILOT_EVERY : PILOT_MIN;
+    int step = 1;
+    while ((long)((width + step) / (step + 1)) * ((height + step) / (step + 1)) >= pilot_want)
         step++;
-    if ((long)((width + step - 1) / step) * ((height + step - 1) / step) < PILOT_MIN)
-        step = 1;
     if (rs_camera_setup(&s->camera, width, height, &view, msg, msg_size) != 0)
         return -1;
     unsigned char *group = malloc((size_t)total);
@@ -279,7 +317,7 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
-    if (pilot_mark(s, base, polarized, step, mark, samples, msg, msg_size) != 0) {
+    if (pilot_mark(s, base, polarized, step, mark, spent, msg, msg_size) != 0) {
         free(group);
         free(mark);
         return -1;
@@ -295,8 +333,8 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
             count[g]++;
             ps->lens_share += lens ? 1.0 / (double)total : 0.0;
         }
-    /* A marked pixel stands for its pilot cell (at most what there is);
-     * the other groups share the rest in proportion. */
+    /* A marked pixel (cell_pixel) stands for its pilot cell (at most what
+     * there is); the other groups share the rest in proportion. */
     {
         double marked = fmin(1.0, (double)count[G_MARKED] * step * step / (double)total);
         long rest = count[G_LENS] + count[G_OTHER];
@@ -327,12 +365,15 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
     }
     size_t at = 0;
     for (int g = 0; g < N_GROUPS; g++) {
-        long seen = 0;
         ps->n[g] = 0;
         for (long k = 0; k < total; k++) {
-            /* start half a stride in: the first pixel of a group is its
-             * corner, rarely typical */
-            if (group[k] != g || (seen++ + every[g] / 2) % every[g] != 0)
+            if (group[k] != g)
+                continue;
+            /* one in every[g], scrambled: a regular stride in scan order
+             * aliases with the image's stripes and edges (default.scene
+             * at 128 x 96: the lens group's sample of a wavelength
+             * doubling's change came out 2.2 times the image's) */
+            if (mix((uint64_t)k) % (uint64_t)every[g] != 0)
                 continue;
             ps->px[2 * at] = (int)(k % width);
             ps->px[2 * at + 1] = (int)(k / width);
@@ -345,12 +386,31 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
     return 0;
 }
 
-/* Render the probe pixels with opts into out[0..n). */
-static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set *ps,
-                 rs_color *out, double *samples, char *msg, size_t msg_size)
+/* One probe render: each probe pixel's colour, and the cost the setting
+ * would have on the whole image (each group's cost per pixel times the
+ * pixels it stands for). */
+typedef struct shot {
+    rs_color *c;
+    double cost;
+} shot;
+
+static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set *ps, shot *out,
+                 double *spent, char *msg, size_t msg_size)
 {
-    return render_pixels(s, opts, ps->px, ps->n[G_MARKED] + ps->n[G_LENS] + ps->n[G_OTHER],
-                         out, samples, msg, msg_size);
+    double gc[N_GROUPS];
+    size_t n = ps->n[G_MARKED] + ps->n[G_LENS] + ps->n[G_OTHER];
+    out->c = malloc(sizeof *out->c * (n + 1));
+    if (!out->c) {
+        snprintf(msg, msg_size, "out of memory");
+        return -1;
+    }
+    if (render_pixels(s, opts, ps->px, ps->n, N_GROUPS, out->c, gc, spent, msg, msg_size) != 0)
+        return -1;
+    out->cost = 0.0;
+    for (int g = 0; g < N_GROUPS; g++)
+        if (ps->n[g])
+            out->cost += gc[g] * ps->pop[g] / (double)ps->n[g];
+    return 0;
 }
 
 /* RMS difference over the image, estimated from the probe: each group's
@@ -381,178 +441,275 @@ static double rms_diff(const probe_set *ps, const rs_color *a, const rs_color *b
     return sqrt(total);
 }
 
+/* The grid's cut-offs, largest first (the sweep's, speed_accuracy). */
+static const double CUTOFFS[] = {1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12};
+#define N_CUTOFFS (sizeof CUTOFFS / sizeof *CUTOFFS)
+#define TREES_MAX (4 * N_CUTOFFS)
+
+typedef struct tree {
+    int depth;
+    double cutoff;
+    shot s;    /* the ladder's model at the first rung */
+    double e;  /* e_tree */
+} tree;
+
+typedef struct choice {
+    rs_mode mode;
+    int wavelengths, tree, rung; /* rung -1: rgb */
+    double e, e_wl, e_tree, e_model, cost;
+} choice;
+
+static void consider(choice *best, int *n_cand, double E, choice c)
+{
+    (*n_cand)++;
+    if (c.e <= E && (best->cost < 0.0 || c.cost < best->cost))
+        *best = c;
+}
+
+/* The cheapest candidate whose estimate is within E (cost < 0: none),
+ * from the measurements so far (see auto_settings.h); *n_cand counts
+ * the candidates. */
+static choice choose(const probe_set *ps, double E, int pol_only, rs_mode L, const tree *tr,
+                     int n_trees, int t_lad, const shot *rung, const int *rung_n, int n_rungs,
+                     double e_top, const double *e_model, const double *mcost, const shot *rgb,
+                     int *n_cand)
+{
+    static const rs_mode spectral[3] = {RS_MODE_FRESNEL, RS_MODE_SCHLICK, RS_MODE_POLARIZED};
+    choice best = {RS_MODE_POLARIZED, 0, 0, 0, INFINITY, 0, 0, 0, -1.0};
+    const shot *top = &rung[n_rungs - 1];
+    /* a single rung has no estimate of its own error */
+    double e_t = n_rungs > 1 ? e_top : INFINITY;
+    *n_cand = 0;
+    for (int k = 0; k < n_rungs; k++) {
+        double e_wl = (k == n_rungs - 1 ? 0.0 : rms_diff(ps, rung[k].c, top->c)) + e_t;
+        for (int t = 0; t < n_trees; t++) {
+            double tcost = tr[t].s.cost / tr[t_lad].s.cost;
+            for (int m = 0; m < 3; m++) {
+                if (pol_only && spectral[m] != RS_MODE_POLARIZED)
+                    continue;
+                choice c = {spectral[m], rung_n[k], t, k, 0, e_wl, tr[t].e, e_model[spectral[m]], 0};
+                c.e = c.e_wl + c.e_tree + c.e_model;
+                c.cost = rung[k].cost * tcost * mcost[spectral[m]];
+                consider(&best, n_cand, E, c);
+            }
+        }
+    }
+    if (!pol_only)
+        for (int t = 0; t < n_trees; t++) {
+            if (!rgb[t].c)
+                continue;
+            choice c = {RS_MODE_RGB, 0, t, -1, 0, 0, 0, 0, rgb[t].cost};
+            c.e = rms_diff(ps, rgb[t].c, top->c) + e_t + tr[t_lad].e + e_model[L];
+            c.e_model = c.e;
+            consider(&best, n_cand, E, c);
+        }
+    return best;
+}
+
 int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_opts *out,
-                   double *probe_samples, char *why, size_t why_size, char *msg,
-                   size_t msg_size)
+                   rs_auto_cost *cost, char *why, size_t why_size, char *msg, size_t msg_size)
 {
     const double E = req->tolerance;
     const char *pol_reason = needs_polarized(scene);
-    double lmax = radiance_max(scene), d_model = -1.0, budget, e_wl, e_at, samples = 0.0;
-    double d_prev = -1.0, d_last = -1.0, p = 1.0, d_cut = 0.0, floor_cut;
-    int rc = -1, n_lenses, over = 0;
+    const rs_mode L = pol_reason ? RS_MODE_POLARIZED : RS_MODE_FRESNEL;
+    double lmax = radiance_max(scene), spent = 0.0, budget, floor_cut, e_star;
+    int rc = -1, n_lenses, n_trees = 0, n_rungs = 0, t_star, t_lad, n_cand = 0, over = 0;
     double dn = dispersion_max(scene, &n_lenses);
-    size_t n;
     probe_set ps = {NULL, {0, 0, 0}, {0, 0, 0}, 0.0, {0, 0, 0}};
-    rs_color *cur = NULL, *next = NULL, *tmp;
+    tree tr[TREES_MAX];
+    shot rung[RUNGS_MAX], pol = {NULL, 0.0}, sch = {NULL, 0.0}, rgb[TREES_MAX];
+    int rung_n[RUNGS_MAX];
+    double e_top = INFINITY, e_model[4] = {0, 0, 0, 0}, mcost[4] = {1, 1, 1, 1};
+    double rung_spent = 0.0;
+    int depths[4], n_depths = 0, depth_max;
     rs_render_opts o;
+    choice best = {RS_MODE_POLARIZED, 0, 0, 0, INFINITY, 0, 0, 0, -1.0};
 
+    memset(tr, 0, sizeof tr);
+    memset(rung, 0, sizeof rung);
+    memset(rgb, 0, sizeof rgb);
     rs_render_opts_init(&o);
     o.width = req->width;
     o.height = req->height;
-    o.depth = req->depth > 0 ? req->depth
-              : scene->settings.max_trace_level > DEPTH_MIN ? scene->settings.max_trace_level
-                                                           : DEPTH_MIN;
-    /* The cut-off's floor, from the library's per-branch bounds: an
-     * incoherent branch of weight w carries at most w lmax; a coherent
-     * one adds up to 2 sqrt(w) lmax through its cross term with a ray of
-     * weight 1, so there the weight is squared.  Below the floor no
-     * dropped branch carries more than SHARE_CUTOFF E. */
+
+    /* The trees: depth 4, 8, 16 and 32 (or the scene's max_trace_level
+     * when deeper: crossed_polarizers at 128 x 96 changes by 4.3e-3 RMS
+     * from depth 16 to 32, by 3e-8 from 32 to 64); cut-offs of the grid
+     * down to the floor (below 1e-6 only from depth 16 on), from the library's per-branch bounds: an incoherent
+     * branch of weight w carries at most w lmax; a coherent one adds up
+     * to 2 sqrt(w) lmax through its cross term with a ray of weight 1, so
+     * there the weight is squared.  Below the floor no dropped branch
+     * carries more than SHARE_CUTOFF E. */
     budget = SHARE_CUTOFF * E / lmax;
     floor_cut = coherent(scene) ? 0.25 * budget * budget : fmin(1.0, budget);
+    depth_max = req->depth > 0 ? req->depth
+                : scene->settings.max_trace_level > DEPTH_MIN ? scene->settings.max_trace_level
+                                                             : DEPTH_MIN;
+    if (req->depth > 0) {
+        depths[n_depths++] = req->depth;
+    } else {
+        depths[n_depths++] = 4;
+        depths[n_depths++] = 8;
+        depths[n_depths++] = 16;
+        depths[n_depths++] = depth_max;
+    }
+    for (int d = 0; d < n_depths; d++) {
+        if (req->cutoff >= 0.0) {
+            tr[n_trees].depth = depths[d];
+            tr[n_trees++].cutoff = req->cutoff;
+            continue;
+        }
+        for (size_t c = 0; c < N_CUTOFFS; c++) {
+            tr[n_trees].depth = depths[d];
+            tr[n_trees++].cutoff = CUTOFFS[c];
+            if (CUTOFFS[c] <= floor_cut ||
+                (depths[d] < DEEP_CUT_DEPTH && CUTOFFS[c] <= 1e-6))
+                break;
+        }
+    }
+    t_star = n_trees - 1; /* the deepest depth's lowest cut-off */
+    e_star = req->cutoff >= 0.0 ? 0.0 : SHARE_CUTOFF * E;
 
     {
         rs_render_opts pilot = o;
-        pilot.cutoff = req->cutoff >= 0.0 ? req->cutoff : CUT_FIRST;
-        if (probe_pick(scene, &pilot, pol_reason != NULL, &ps, &samples, msg, msg_size) != 0)
+        pilot.depth = depth_max;
+        pilot.cutoff = req->cutoff >= 0.0 ? req->cutoff : CUTOFFS[0];
+        if (probe_pick(scene, &pilot, pol_reason != NULL, &ps, &spent, msg, msg_size) != 0)
             return -1;
     }
-    n = ps.n[G_MARKED] + ps.n[G_LENS] + ps.n[G_OTHER];
-    cur = malloc(sizeof *cur * (n + 1));
-    next = malloc(sizeof *next * (n + 1));
-    if (!cur || !next) {
-        snprintf(msg, msg_size, "out of memory");
-        goto done;
-    }
 
-    /* The cut-off: most dropped branches carry far less than their bound
-     * (they see a dark background, or light the image does not reach),
-     * so a ladder of cut-offs from CUT_FIRST down by CUT_STEP is measured
-     * on the probe (polarized, at the first wavelength rung) and the
-     * first whose change to the next is, times SAFETY, within SHARE_TREE
-     * of E stands; the floor ends the ladder. */
+    /* Every tree, in rgb (cheap, and each an rgb candidate) or, where the
+     * scene needs it, polarized at the first rung; e_tree against T*. */
+    o.mode = L;
     o.wavelengths = req->wavelengths > 0 ? req->wavelengths : N_FIRST;
-    o.mode = RS_MODE_POLARIZED;
-    if (req->cutoff >= 0.0) {
-        o.cutoff = req->cutoff;
-        if (probe(scene, &o, &ps, cur, &samples, msg, msg_size) != 0)
-            goto done;
-    } else if (coherent(scene)) {
-        /* no ladder: an interfering branch matters far below its weight,
-         * and a decade of cut-offs without branches reads as converged
-         * (newtons_rings at 12 x 9: the ladder stopped at 0.01, whose
-         * next rung renders alike, 6.3e-3 off) */
-        o.cutoff = floor_cut;
-        d_cut = SHARE_CUTOFF * E / SAFETY;
-        if (probe(scene, &o, &ps, cur, &samples, msg, msg_size) != 0)
-            goto done;
-    } else {
-        double c = CUT_FIRST > floor_cut ? CUT_FIRST : floor_cut;
-        o.cutoff = c;
-        if (probe(scene, &o, &ps, cur, &samples, msg, msg_size) != 0)
-            goto done;
-        while (c > floor_cut) {
-            rs_render_opts f = o;
-            f.cutoff = c * CUT_STEP > floor_cut ? c * CUT_STEP : floor_cut;
-            if (probe(scene, &f, &ps, next, &samples, msg, msg_size) != 0)
-                goto done;
-            d_cut = rms_diff(&ps, cur, next);
-            if (SAFETY * d_cut <= SHARE_TREE * E)
-                break;
-            c = f.cutoff;
-            o.cutoff = c;
-            tmp = cur, cur = next, next = tmp;
-        }
-        if (o.cutoff <= floor_cut)
-            d_cut = SHARE_CUTOFF * E / SAFETY; /* the bound's promise */
-    }
-    /* The model: polarized where the scene needs it; else fresnel when
-     * its departure from polarized, measured on the probe at the first
-     * rung, is within its share of E. */
-    if (!pol_reason) {
+    for (int t = 0; t < n_trees; t++) {
         rs_render_opts f = o;
-        f.mode = RS_MODE_FRESNEL;
-        if (probe(scene, &f, &ps, next, &samples, msg, msg_size) != 0)
+        f.mode = pol_reason ? RS_MODE_POLARIZED : RS_MODE_RGB;
+        f.depth = tr[t].depth;
+        f.cutoff = tr[t].cutoff;
+        if (probe(scene, &f, &ps, &tr[t].s, &spent, msg, msg_size) != 0)
             goto done;
-        d_model = rms_diff(&ps, cur, next);
-        if (d_model <= SHARE_MODEL * E) {
-            o.mode = RS_MODE_FRESNEL;
-            tmp = cur, cur = next, next = tmp;
-        }
+        if (!pol_reason)
+            rgb[t] = tr[t].s; /* not owned */
     }
-    e_wl = E - SAFETY * d_cut - (o.mode == RS_MODE_FRESNEL ? d_model : 0.0);
+    for (int t = 0; t < n_trees; t++)
+        tr[t].e = rms_diff(&ps, tr[t].s.c, tr[t_star].s.c) + e_star;
+    /* The ladder's tree: the cheapest within TREE_LADDER of E. */
+    t_lad = t_star;
+    for (int t = 0; t < n_trees; t++)
+        if (tr[t].e <= TREE_LADDER * E && tr[t].s.cost < tr[t_lad].s.cost)
+            t_lad = t;
 
-    /* The wavelengths: a ladder N, 2N, 4N ... on the probe, climbed until
-     * the change from N to 2N, times SAFETY, is within the wavelength
-     * budget (without dispersion and pigment spectra the change is 0 and
-     * the first rung stands).  Only rungs are chosen: the error of a
-     * count between two rungs is not measured, and it is not monotone in
-     * N (conical_rim at 12 x 9: 16 wavelengths 3.4e-3 off, 12: 1.3e-2);
-     * small odd counts are worse still (biconcave at 32 x 24, fresnel: 4
-     * wavelengths 3.5e-3, 5: 4.6e-2, 9: 1.5e-2, 17: 6.7e-3).  At the
-     * last rung the error is extrapolated as N^-p, p from the last two
-     * changes. */
-    if (req->wavelengths > 0) {
-        e_at = -1.0; /* the user's: not estimated */
-    } else {
-        for (;;) {
-            rs_render_opts h = o;
-            h.wavelengths = 2 * o.wavelengths;
-            if (probe(scene, &h, &ps, next, &samples, msg, msg_size) != 0)
-                goto done;
-            d_prev = d_last;
-            d_last = rms_diff(&ps, cur, next);
-            if (SAFETY * d_last <= e_wl)
-                break;
-            o.wavelengths = h.wavelengths;
-            tmp = cur, cur = next, next = tmp;
-            if (o.wavelengths >= WAVELENGTHS_MAX) {
-                over = 1;
-                break;
-            }
-        }
-        if (d_prev > 0.0 && d_last > 0.0) {
-            p = log2(d_prev / d_last);
-            p = p < P_MIN ? P_MIN : p > P_MAX ? P_MAX : p;
-        }
-        e_at = SAFETY * d_last * (over ? pow(2.0, -p) : 1.0);
-    }
+    /* The ladder's first rung, and the models there: their departure from
+     * polarized and their cost relative to L. */
     {
-        char model[200], lens[160];
-        double render = (double)req->width * req->height * o.wavelengths;
+        rs_render_opts f = o;
+        f.depth = tr[t_lad].depth;
+        f.cutoff = tr[t_lad].cutoff;
+        if (probe(scene, &f, &ps, &rung[0], &spent, msg, msg_size) != 0)
+            goto done;
+        if (!pol_reason) {
+            f.mode = RS_MODE_POLARIZED;
+            if (probe(scene, &f, &ps, &pol, &spent, msg, msg_size) != 0)
+                goto done;
+            f.mode = RS_MODE_SCHLICK;
+            if (probe(scene, &f, &ps, &sch, &spent, msg, msg_size) != 0)
+                goto done;
+            e_model[RS_MODE_FRESNEL] = rms_diff(&ps, rung[0].c, pol.c);
+            e_model[RS_MODE_SCHLICK] = rms_diff(&ps, sch.c, pol.c);
+            mcost[RS_MODE_POLARIZED] = pol.cost / rung[0].cost;
+            mcost[RS_MODE_SCHLICK] = sch.cost / rung[0].cost;
+        }
+    }
+
+    /* The ladder: N, 2N, ... in L at the ladder's tree; the top's error is
+     * the last doubling's change.  It climbs until that change is within
+     * TOP_SHARE E, or once some candidate meets E, until the next rung
+     * would cost the probe more than CLIMB_SHARE of that candidate's
+     * render (a rung's estimate can only halve the wavelengths). */
+    rung_n[0] = o.wavelengths;
+    n_rungs = 1;
+    for (;;) {
+        double before = spent;
+        best = choose(&ps, E, pol_reason != NULL, L, tr, n_trees, t_lad, rung, rung_n, n_rungs,
+                      e_top, e_model, mcost, rgb, &n_cand);
+        if (req->wavelengths > 0 || rung_n[n_rungs - 1] >= WAVELENGTHS_MAX ||
+            n_rungs == RUNGS_MAX || (n_rungs > 1 && e_top <= TOP_SHARE * E) ||
+            (best.cost >= 0.0 && 2.0 * rung_spent > CLIMB_SHARE * best.cost))
+            break;
+        rs_render_opts f = o;
+        f.depth = tr[t_lad].depth;
+        f.cutoff = tr[t_lad].cutoff;
+        f.wavelengths = 2 * rung_n[n_rungs - 1];
+        if (probe(scene, &f, &ps, &rung[n_rungs], &spent, msg, msg_size) != 0)
+            goto done;
+        rung_spent = spent - before;
+        rung_n[n_rungs] = f.wavelengths;
+        e_top = rms_diff(&ps, rung[n_rungs - 1].c, rung[n_rungs].c);
+        n_rungs++;
+    }
+    if (best.cost < 0.0) {
+        /* nothing meets E: the most accurate there is */
+        best = (choice){RS_MODE_POLARIZED, rung_n[n_rungs - 1], t_star, n_rungs - 1, 0, e_top,
+                        tr[t_star].e, 0, 0};
+        best.e = best.e_wl + best.e_tree;
+        best.cost = rung[n_rungs - 1].cost * tr[t_star].s.cost / tr[t_lad].s.cost *
+                    mcost[RS_MODE_POLARIZED];
+        over = 1;
+    }
+
+    o.mode = best.mode;
+    o.wavelengths = best.mode == RS_MODE_RGB ? o.wavelengths : best.wavelengths;
+    o.depth = tr[best.tree].depth;
+    o.cutoff = tr[best.tree].cutoff;
+    {
+        char model[160], lens[160], parts[160];
+        size_t n = ps.n[G_MARKED] + ps.n[G_LENS] + ps.n[G_OTHER];
         if (pol_reason)
-            snprintf(model, sizeof model, "%s", pol_reason);
+            snprintf(model, sizeof model, "polarized only: %s", pol_reason);
         else
-            snprintf(model, sizeof model,
-                     "no polarizer, crystal or coherent light, and fresnel departs from "
-                     "polarized by %.2g, %s half of E",
-                     d_model, o.mode == RS_MODE_FRESNEL ? "within" : "over");
+            snprintf(model, sizeof model, "no polarizer, crystal or coherent light");
         if (n_lenses)
             snprintf(lens, sizeof lens, "%d lens%s (largest n(400)-n(700) %.3g) on %.0f %% of the image",
                      n_lenses, n_lenses > 1 ? "es" : "", dn, 100.0 * ps.lens_share);
         else
             snprintf(lens, sizeof lens, "no lens");
-        if (e_at >= 0.0)
+        if (best.mode == RS_MODE_RGB)
+            snprintf(parts, sizeof parts, "measured against %d wavelengths", rung_n[n_rungs - 1]);
+        else
+            snprintf(parts, sizeof parts, "wavelengths %.2g + tree %.2g + model %.2g", best.e_wl,
+                     best.e_tree, best.e_model);
+        if (best.mode == RS_MODE_RGB)
             snprintf(why, why_size,
-                     "%s, %d wavelengths, depth %d, cut-off %.3g for E = %.3g: %s; %s; "
-                     "wavelength error %.2g%s, cut-off's %.2g (%zu probe pixels, %.0f %% of the "
-                     "render's samples)",
-                     rs_mode_name(o.mode), o.wavelengths, o.depth, o.cutoff, E, model, lens,
-                     e_at, over ? ", over E: more wavelengths than the limit would be needed" : "",
-                     SAFETY * d_cut, n, 100.0 * samples / render);
+                     "rgb, depth %d, cut-off %.3g for E = %.3g: estimated error %.2g (%s), the "
+                     "cheapest of %d candidates; %s; %s; probe %zu pixels, %.0f %% of the render's "
+                     "cost",
+                     o.depth, o.cutoff, E, best.e, parts, n_cand, model, lens, n,
+                     100.0 * spent / best.cost);
         else
             snprintf(why, why_size,
-                     "%s, %d wavelengths (yours), depth %d, cut-off %.3g for E = %.3g: %s; %s; "
-                     "a dropped branch carries < %.2g",
-                     rs_mode_name(o.mode), o.wavelengths, o.depth, o.cutoff, E, model, lens,
-                     SHARE_CUTOFF * E);
+                     "%s, %d wavelengths%s, depth %d, cut-off %.3g for E = %.3g: estimated error "
+                     "%.2g (%s)%s, the cheapest of %d candidates; %s; %s; probe %zu pixels, %.0f %% "
+                     "of the render's cost",
+                     rs_mode_name(o.mode), o.wavelengths, req->wavelengths > 0 ? " (yours)" : "",
+                     o.depth, o.cutoff, E, best.e, parts,
+                     over ? ", over E: no candidate meets it" : "", n_cand, model, lens, n,
+                     100.0 * spent / best.cost);
     }
     *out = o;
-    if (probe_samples)
-        *probe_samples = samples;
+    if (cost) {
+        cost->probe = spent;
+        cost->render = best.cost;
+    }
     rc = 0;
 done:
     free(ps.px);
-    free(cur);
-    free(next);
+    for (int t = 0; t < n_trees; t++) {
+        free(tr[t].s.c);
+    }
+    for (int k = 0; k < RUNGS_MAX; k++)
+        free(rung[k].c);
+    free(pol.c);
+    free(sch.c);
     return rc;
 }

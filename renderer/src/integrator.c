@@ -174,6 +174,7 @@ struct rs_worker {
     size_t cc_n;          /* entries used per table */
     double *cc_val;       /* [(kind * cc_n + entry) * n_lanes + lane] */
     unsigned *cc_stamp;   /* the same */
+    rs_work work;         /* what this worker has traced (rs_worker_work) */
 };
 
 /* Source ids: 0 ambient, 1 background, 2 + k light k, 2 + L + i object i. */
@@ -1115,6 +1116,8 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
     const rs_integrator *it = w->it;
     const rs_scene *sc = it->scene;
 
+    w->work.rays += 1.0;
+    w->work.lane_rays += n;
     if (!hit) {
         for (int k = 0; k < n; k++)
             out[k] = it->lane_background[lane[k]];
@@ -1135,6 +1138,7 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
         while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
+            w->work.builds += 1.0;
             for (int k = 0; k < m; k++)
                 fr->acc[k] = 0.0;
             for (size_t j = 0; j < nq; j++) {
@@ -1600,6 +1604,8 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
     const rs_scene *sc = it->scene;
     size_t start = out->n;
 
+    w->work.rays += 1.0;
+    w->work.lane_rays += n;
     if (!hit) {
         emit_ctx e = emit_ctx_make(out, d, -1);
         frame *fr = n > 1 ? get_frame(w, f) : NULL;
@@ -1640,12 +1646,14 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             uint64_t hit_id = ++w->splits;
+            w->work.builds += 1.0;
             for (size_t j = 0; j < nq; j++) {
                 bundle_clear(&fr->child);
                 trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
                               level + q[j].depth, weight * q[j].bound, f + 1, &fr->child);
                 if (fr->child.n == 0)
                     continue;
+                w->work.gathered += (double)fr->child.n;
                 if (m > 1) {
                     if (gather_shared(w, fr, j, split, !ob->u.lens.desc.uniaxial, hit_id, q, out) != 0)
                         return;
@@ -1805,6 +1813,19 @@ static void ray_colour(const rs_integrator *it, rs_worker *w, lp_vec3 o, lp_vec3
     out->r = M[0][0] * raw.r + M[0][1] * raw.g + M[0][2] * raw.b + rl.r;
     out->g = M[1][0] * raw.r + M[1][1] * raw.g + M[1][2] * raw.b + rl.g;
     out->b = M[2][0] * raw.r + M[2][1] * raw.g + M[2][2] * raw.b + rl.b;
+}
+
+void rs_worker_work(const rs_worker *w, rs_work *out)
+{
+    *out = w->work;
+}
+
+double rs_work_cost(const rs_work *w, rs_mode mode, double pixels)
+{
+    if (mode == RS_MODE_POLARIZED)
+        return 1728.0 * w->rays + 204.0 * w->lane_rays + 1900.0 * w->builds +
+               2339.0 * w->gathered + 2122.0 * pixels;
+    return 2185.0 * w->rays + 110.0 * w->lane_rays + 2179.0 * w->builds + 1060.0 * pixels;
 }
 
 void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs_color *out)

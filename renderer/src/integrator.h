@@ -56,4 +56,23 @@ void rs_worker_destroy(rs_worker *w);
 void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j,
                          rs_color *out);
 
+/* What a worker has traced since it was created: a measure of cost that
+ * does not depend on the machine or its load (the automatic mode prices
+ * its candidates with it).  rays: rays traced (each a scene intersection
+ * and the shading or lens hit there); lane_rays: the lanes they carried,
+ * summed; builds: lens hits' backward builds (one per sub-packet of equal
+ * optics); gathered: rays gathered back through lenses (polarized). */
+typedef struct rs_work {
+    double rays, lane_rays, builds, gathered;
+} rs_work;
+
+void rs_worker_work(const rs_worker *w, rs_work *out);
+
+/* The cost of work w done on `pixels` pixels in a mode, in instructions
+ * of this renderer: a linear fit of callgrind's counts of 200 renders (10
+ * shipped scenes, every mode, 4-64 wavelengths, depth 4 and 16, cut-off
+ * 1e-3 and 1e-6, 24 x 18 pixels), 0.55-1.5 times the count, 20 % RMS.
+ * Deterministic: it prices what a render will cost on any machine. */
+double rs_work_cost(const rs_work *w, rs_mode mode, double pixels);
+
 #endif

@@ -72,7 +72,7 @@ static const char *field(const char *s, char *out, size_t size)
 int sa_points_read_csv(const char *path, sa_points *ps, char *msg, size_t msg_size)
 {
     FILE *f = fopen(path, "r");
-    char line[1024], v[13][256];
+    char line[2048], v[13][512];
     int ln = 0;
     if (!f) {
         snprintf(msg, msg_size, "cannot open");

@@ -27,7 +27,7 @@ typedef struct sa_point {
     double seconds;
     int runs;
     sa_error err;
-    char note[256];
+    char note[512];
 } sa_point;
 
 /* A point of the given kind and setting, nothing measured yet. */

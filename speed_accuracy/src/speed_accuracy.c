@@ -36,8 +36,9 @@
 static const char *const usage_text[] = {
 "usage: speed_accuracy [--bin DIR] [--scenes DIR] [--docs DIR] [--work DIR]\n"
 "                      [--width W] [--height H] [--runs K] [--scene NAME]...\n"
-"                      [--max-wavelengths N] [--reference-seconds S]\n"
-"                      [--point-seconds S] [--reuse-references]\n"
+"                      [--max-wavelengths N] [--sweep-wavelengths N]\n"
+"                      [--reference-seconds S]\n"
+"                      [--point-seconds S] [--auto-seconds S] [--reuse-references]\n"
 "       speed_accuracy --chart-only [--docs DIR]\n"
 "       speed_accuracy --help\n"
 "\n"
@@ -48,15 +49,21 @@ static const char *const usage_text[] = {
 "\n",
 "  --bin DIR        where lensrender and pov_compare are (default build/bin)\n"
 "  --work DIR       references and renders (default build/speed-accuracy)\n"
-"  --width W, --height H   image size of every render (default 16 x 12)\n"
+"  --width W, --height H   image size of every render (default 128 x 96:\n"
+"                   a process's fixed cost, 3 ms, is <= 25 % of the cheapest\n"
+"                   render's)\n"
 "  --runs K         timed runs per setting; its time is their median\n"
 "                   (default 3; a setting slower than 1 s runs once)\n"
 "  --scene NAME     only this scene (repeatable; default every *.scene)\n"
 "  --max-wavelengths N   the reference's wavelength cap, <= 16384 (default 16384)\n"
+"  --sweep-wavelengths N   the swept settings' largest wavelength count\n"
+"                   (default 512)\n"
 "  --reference-seconds S   no reference doubling predicted (2.5 x the last\n"
 "                   render) to take longer than S CPU seconds (default 45)\n"
 "  --point-seconds S   no swept setting predicted (from the reference's time\n"
 "                   per wavelength) to take longer than S (default 10)\n"
+"  --auto-seconds S    an auto render (its probe included) that takes more\n"
+"                   CPU time is left out (default 300)\n"
 "  --reuse-references    keep references already in the work directory\n"
 "  --references-only     make the references and stop\n"
 "\n"
@@ -78,8 +85,10 @@ static const char *const usage_text[] = {
 typedef struct opts {
     const char *bin, *scenes, *docs, *work;
     int width, height, runs, max_wavelengths, reuse, chart_only, references_only;
+    int sweep_wavelengths; /* the sweep's largest wavelength count */
     double reference_seconds; /* a reference doubling predicted slower is not run */
     double point_seconds;     /* a swept setting predicted slower is not run */
+    double auto_seconds;      /* an auto point that runs longer is left out */
     int rank; /* this process's, in a run across processes (names its renders) */
     const char *only[64];
     int n_only;
@@ -471,27 +480,32 @@ static int povray_point(const scene_ctx *sc, sa_point *p, rs_image *img)
 
 static const char *const MODELS[] = {"polarized", "fresnel", "schlick", "rgb"};
 static const int WAVELENGTHS[] = {4, 8, 16, 32, 64, 128, 256, 512};
-static const int DEPTHS[] = {4, 8, 16};
-/* 1e-6, not 0: without a cut-off a birefringent plate's tree doubles at
- * every bounce (see the reference); 1e-6 of the light is below every E. */
-static const double CUTOFFS[] = {1e-6, 1e-3, -1.0}; /* -1: the scene's adc_bailout */
+static const int DEPTHS[] = {4, 8, 16, 32};
+/* --mode auto's grid (renderer/src/auto_settings.c): cut-offs 1e-2 ...
+ * 1e-6 at every depth, 1e-8 ... 1e-12 (coherent scenes' floors) from
+ * depth 16 on; and the scene's own (-1: its adc_bailout) at depth 16, the
+ * default's. */
+static const double CUTOFFS[] = {1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-10, 1e-12, -1.0};
 static const double TOLERANCES[] = {1e-2, 1e-3, 1e-4};
 
 #define N_OF(a) (sizeof(a) / sizeof *(a))
 
-/* Is the setting in the sweep?  Every model, depth and cut-off up to 64
- * wavelengths; beyond, the two models that can converge (polarized; and
- * fresnel, for scenes where it is exact enough) at depth 16 without
- * cut-off and at depth 8 with cut-off 1e-3; schlick at depth 16 without
- * cut-off; rgb has no wavelength count. */
+/* Is the setting in the sweep?  The grid auto chooses from, pruned where
+ * a setting cannot be on the front: cut-offs below 1e-6 only from depth
+ * 16 on (auto uses them only there), the scene's own only at depth 16;
+ * from 64 wavelengths on, where the wavelength error is below 1e-3, only
+ * the trees whose own error can be too (depth 8 and deeper, cut-off 1e-3
+ * and below); rgb has no wavelength count. */
 static int in_sweep(int m, int wl, int d, int c)
 {
-    int full = WAVELENGTHS[wl] <= 32;
-    if (m == 3)
-        return wl == 0;
-    if (m == 2)
-        return DEPTHS[d] == 16 && c == 0;
-    return full || (DEPTHS[d] == 16 && c == 0) || (DEPTHS[d] == 8 && CUTOFFS[c] == 1e-3);
+    double cut = CUTOFFS[c];
+    if (m == 3 && wl != 0)
+        return 0;
+    if ((cut < 0.0 && DEPTHS[d] != 16) || (cut >= 0.0 && cut < 1e-6 && DEPTHS[d] < 16))
+        return 0;
+    if (m != 3 && WAVELENGTHS[wl] >= 64 && (DEPTHS[d] < 8 || cut > 1e-3 || cut < 0.0))
+        return 0;
+    return 1;
 }
 
 /* ---- the runs, spread over the processes of the run -------------------
@@ -566,7 +580,8 @@ static int list_points(sweep *w, int k)
                         continue;
                     /* Predicted from the reference's time per wavelength
                      * (deeper, a lower cut-off, polarized: an upper bound). */
-                    if (m != 3 && WAVELENGTHS[wl] * w->sc[k].rn.s_per_wl > w->o->point_seconds)
+                    if (m != 3 && (WAVELENGTHS[wl] * w->sc[k].rn.s_per_wl > w->o->point_seconds ||
+                                   WAVELENGTHS[wl] > w->o->sweep_wavelengths))
                         continue;
                     sa_point_init(&p, "sweep", MODELS[m], m == 3 ? 0 : WAVELENGTHS[wl],
                                   DEPTHS[d], CUTOFFS[c]);
@@ -667,9 +682,13 @@ static int point_run(void *user, long k, void *result, size_t *used, char *msg,
     } else {
         /* A swept point that runs out of 4 x --point-seconds is left out (no
          * image): the time predicted from the cheap render does not know
-         * a scene's own cut-off of 0 on a birefringent tree. */
-        rc = render(&w->sc[jp->scene], &h.p, w->o->runs,
-                    strcmp(h.p.kind, "sweep") == 0 ? 4.0 * w->o->point_seconds : 0.0, &img);
+         * a scene's own cut-off of 0 on a birefringent tree.  An auto
+         * point that runs out of --auto-seconds too (thousands of
+         * wavelengths through dispersive glass at E = 1e-4). */
+        double limit = strcmp(h.p.kind, "sweep") == 0  ? 4.0 * w->o->point_seconds
+                       : strcmp(h.p.kind, "auto") == 0 ? w->o->auto_seconds
+                                                       : 0.0;
+        rc = render(&w->sc[jp->scene], &h.p, w->o->runs, limit, &img);
         if (rc == 1) {
             memset(&h.p.err, 0, sizeof h.p.err);
             rc = 0;
@@ -826,12 +845,14 @@ static int parse(opts *o, int argc, char **argv)
     o->scenes = "scenes";
     o->docs = "docs";
     o->work = "build/speed-accuracy";
-    o->width = 16;
-    o->height = 12;
+    o->width = 128;
+    o->height = 96;
     o->runs = 3;
     o->max_wavelengths = 16384;
+    o->sweep_wavelengths = 512;
     o->reference_seconds = 45.0;
     o->point_seconds = 10.0;
+    o->auto_seconds = 300.0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -856,14 +877,16 @@ static int parse(opts *o, int argc, char **argv)
             o->docs = v, i++;
         } else if (strcmp(a, "--work") == 0) {
             o->work = v, i++;
-        } else if (strcmp(a, "--reference-seconds") == 0 || strcmp(a, "--point-seconds") == 0) {
+        } else if (strcmp(a, "--reference-seconds") == 0 || strcmp(a, "--point-seconds") == 0 ||
+                   strcmp(a, "--auto-seconds") == 0) {
             char *end;
             double x = strtod(v, &end);
             if (end == v || *end || !(x > 0.0 && x <= 1e6)) {
                 say("%s: '%s' is out of range", a, v);
                 return -1;
             }
-            *(a[2] == 'r' ? &o->reference_seconds : &o->point_seconds) = x;
+            *(a[2] == 'r' ? &o->reference_seconds
+              : a[2] == 'p' ? &o->point_seconds : &o->auto_seconds) = x;
             i++;
         } else if (strcmp(a, "--scene") == 0) {
             if (o->n_only == (int)N_OF(o->only)) {
@@ -872,9 +895,11 @@ static int parse(opts *o, int argc, char **argv)
             }
             o->only[o->n_only++] = v, i++;
         } else if (strcmp(a, "--width") == 0 || strcmp(a, "--height") == 0 ||
-                   strcmp(a, "--runs") == 0 || strcmp(a, "--max-wavelengths") == 0) {
+                   strcmp(a, "--runs") == 0 || strcmp(a, "--max-wavelengths") == 0 ||
+                   strcmp(a, "--sweep-wavelengths") == 0) {
             int *dst = a[2] == 'w' ? &o->width : a[2] == 'h' ? &o->height
-                       : a[2] == 'r' ? &o->runs : &o->max_wavelengths;
+                       : a[2] == 'r' ? &o->runs : a[2] == 'm' ? &o->max_wavelengths
+                                                 : &o->sweep_wavelengths;
             if (int_arg(v, 1, a[2] == 'r' ? 15 : 16384, dst) != 0) {
                 say("%s: '%s' is out of range", a, v);
                 return -1;

@@ -1,7 +1,8 @@
 /* test_speed_accuracy.c -- the speed-accuracy sweep, end to end, small.
  *
  * speed_accuracy on two scenes of its own at 4 x 3 pixels, one run per
- * point, the reference capped at 256 wavelengths:
+ * point, the reference capped at 256 wavelengths, the sweep at 4 (its
+ * grid of trees makes some 90 points a scene):
  *   - "emitters": a checker of self-lit RGB emitters seen directly, no
  *     glass.  Every spectral render of an RGB emitter is exactly its RGB
  *     (the colour correction of the wavelength quadrature), so every point
@@ -105,7 +106,7 @@ int main(void)
 
     const char *args[] = {"--bin", LP_BIN_DIR, "--scenes", scenes, "--docs", docs, "--work", work,
                           "--width", "4", "--height", "3", "--runs", "1", "--max-wavelengths",
-                          "256", NULL};
+                          "256", "--sweep-wavelengths", "4", NULL};
     int rc = tp_run(LP_BIN_DIR "/speed_accuracy", args, NULL, &r);
     CHECK(rc == 0 && r.status == 0, "speed_accuracy: status %d: %s", r.status,
           r.err ? r.err : r.error);
