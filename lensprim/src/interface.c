@@ -49,11 +49,6 @@ void lp__node_refit(lp__node *node, const lp__cvec3 *E)
     }
 }
 
-static lp_vec3 reflect_dir(const lp__node *node)
-{
-    return v3_normalize(v3_madd(node->d, node->n, 2.0 * node->cos_i));
-}
-
 double lp__node_reflectance(const lp__node *node, lp_mode mode)
 {
     if (node->f.tir)
@@ -71,15 +66,27 @@ static lp__cvec3 combine(int real, double complex a, lp_vec3 u, double complex b
     return cv3_combine(a, u, b, w);
 }
 
-void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
-                          lp__branch *out)
+void lp__node_reflect_axes(const lp__node *node, lp__axes *ax)
 {
-    lp_vec3 r = reflect_dir(node);
-    lp_vec3 pr = v3_cross(r, node->s);
+    ax->dir = v3_normalize(v3_madd(node->d, node->n, 2.0 * node->cos_i));
+    ax->p = v3_cross(ax->dir, node->s);
+}
+
+void lp__node_transmit_axes(const lp__node *node, lp__axes *ax)
+{
+    double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
+    ax->dir = v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
+    ax->p = v3_cross(ax->dir, node->s);
+}
+
+void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                         const lp__amp *amp, lp__branch *out)
+{
+    lp_vec3 pr = ax->p;
     double complex es = amp->es, ep = amp->ep;
     int real = amp->real;
 
-    out->dir = r;
+    out->dir = ax->dir;
     out->flip = 0;
     if (mode == LP_MODE_POLARIZED) {
         double complex rs = node->f.rs, rp = node->f.rp;
@@ -102,16 +109,14 @@ void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp
     }
 }
 
-void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
-                           lp__branch *out)
+void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                          const lp__amp *amp, lp__branch *out)
 {
-    double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
-    lp_vec3 t = v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
-    lp_vec3 pt = v3_cross(t, node->s);
+    lp_vec3 pt = ax->p;
     double complex es = amp->es, ep = amp->ep;
     int real = amp->real;
 
-    out->dir = t;
+    out->dir = ax->dir;
     out->flip = 0;
     if (mode == LP_MODE_POLARIZED) {
         out->E = combine(real, node->f.ts * es, node->s, node->f.tp * ep, pt);
@@ -120,6 +125,22 @@ void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *am
         double k = sqrt(T > 0.0 ? T : 0.0);
         out->E = combine(real, k * es, node->s, k * ep, pt);
     }
+}
+
+void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
+                          lp__branch *out)
+{
+    lp__axes ax;
+    lp__node_reflect_axes(node, &ax);
+    lp__node_reflect_on(node, &ax, mode, amp, out);
+}
+
+void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
+                           lp__branch *out)
+{
+    lp__axes ax;
+    lp__node_transmit_axes(node, &ax);
+    lp__node_transmit_on(node, &ax, mode, amp, out);
 }
 
 void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp__branch *out)

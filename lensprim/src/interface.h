@@ -88,6 +88,26 @@ void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp
 void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
                            lp__branch *out);
 
+/* A branch's direction and the p axis of its wave (dir x s): what a
+ * branch of a node costs beyond its field.  They are the same for every
+ * field of a node not at normal incidence (there s, hence p, follows the
+ * field: lp__node_refit), so a node that serves many fields computes
+ * them once. */
+typedef struct lp__axes {
+    lp_vec3 dir;  /* unit */
+    lp_vec3 p;    /* dir x s */
+} lp__axes;
+
+void lp__node_reflect_axes(const lp__node *node, lp__axes *ax);
+void lp__node_transmit_axes(const lp__node *node, lp__axes *ax);
+
+/* The branches of G on axes computed for the node as it is: the same as
+ * lp__node_reflect_amp / lp__node_transmit_amp. */
+void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                         const lp__amp *amp, lp__branch *out);
+void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                          const lp__amp *amp, lp__branch *out);
+
 /* Power reflectance of the node in an unpolarized mode (fresnel or
  * schlick); 1 under TIR. */
 double lp__node_reflectance(const lp__node *node, lp_mode mode);
