@@ -65,8 +65,9 @@ typedef struct band {
  * optics that differ only in its intensity: vector s = -1 - lane[i] gives
  * per lane whether the lane has the ray (has[s * nl + lane]) and its
  * intensity there (I[s * nl + lane]); r[i].intensity is that of its first
- * lane.  Each lane's rays, in bundle order, are those tracing the lane
- * alone would give, in that order. */
+ * lane.  Rays may share a vector (a vector is never changed once made).
+ * Each lane's rays, in bundle order, are those tracing the lane alone
+ * would give, in that order. */
 typedef struct bundle {
     lp_ray *r;
     int *lane;
@@ -1237,16 +1238,12 @@ static int shared_halves(int nl, const emit_ctx *e, int source, const int *lane,
             I[l] = 0.5 * v[l];
         }
     }
-    /* the other half: the same intensities (indices, since a push may
-     * move the vectors) */
-    size_t s0 = out->ns - 1;
+    /* the other half: the same lanes and intensities, the same vector */
     double I0 = r->intensity;
-    if (!(r = bundle_push_shared(out, nl, 0, &I, &has)))
+    if (!(r = bundle_push(out, -1 - (int)(out->ns - 1))))
         return -1;
     half_ray(e, source, 1, r);
     r->intensity = I0;
-    memcpy(has, out->has + s0 * (size_t)nl, (size_t)nl);
-    memcpy(I, out->I + s0 * (size_t)nl, (size_t)nl * sizeof *I);
     return 0;
 }
 
