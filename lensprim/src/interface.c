@@ -89,6 +89,11 @@ void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
     out->dir = ax->dir;
     out->flip = 0;
     if (mode == LP_MODE_POLARIZED) {
+        if (real && !node->f.tir) {
+            out->E = cv3_real(lp__node_reflect_real(node, ax, creal(es), creal(ep), &out->flip),
+                              1.0);
+            return;
+        }
         double complex rs = node->f.rs, rp = node->f.rp;
         double mirror = creal(rs) * (creal(es) * creal(es) + cimag(es) * cimag(es)) -
                         creal(rp) * (creal(ep) * creal(ep) + cimag(ep) * cimag(ep));
@@ -97,11 +102,7 @@ void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
             rp = -rp;
             out->flip = 1;
         }
-        real = real && !node->f.tir;
-        if (real)
-            out->E = combine(1, creal(rs) * creal(es), node->s, creal(rp) * creal(ep), pr);
-        else
-            out->E = cv3_combine(rs * es, node->s, rp * ep, pr);
+        out->E = cv3_combine(rs * es, node->s, rp * ep, pr);
     } else {
         /* The mirror image of the field, scaled to the reflected power. */
         double k = sqrt(lp__node_reflectance(node, mode));
@@ -119,7 +120,10 @@ void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode
     out->dir = ax->dir;
     out->flip = 0;
     if (mode == LP_MODE_POLARIZED) {
-        out->E = combine(real, node->f.ts * es, node->s, node->f.tp * ep, pt);
+        if (real)
+            out->E = cv3_real(lp__node_transmit_real(node, ax, creal(es), creal(ep)), 1.0);
+        else
+            out->E = cv3_combine(node->f.ts * es, node->s, node->f.tp * ep, pt);
     } else {
         double T = 1.0 - lp__node_reflectance(node, mode);
         double k = sqrt(T > 0.0 ? T : 0.0);

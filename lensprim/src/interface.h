@@ -108,6 +108,29 @@ void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
 void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
                           const lp__amp *amp, lp__branch *out);
 
+/* The polarized branches of a real field (every field before a total
+ * internal reflection) projected on the node's axes as es, ep, at a node
+ * not under TIR, in real arithmetic: the real parts of what
+ * lp__node_reflect_on / lp__node_transmit_on give (their imaginary parts
+ * are 0), which use these.  *flip as lp__branch.flip. */
+static inline lp_vec3 lp__node_reflect_real(const lp__node *node, const lp__axes *ax, double es,
+                                            double ep, int *flip)
+{
+    double rs = creal(node->f.rs), rp = creal(node->f.rp);
+    *flip = rs * (es * es) - rp * (ep * ep) < 0.0;
+    if (*flip) {
+        rs = -rs;
+        rp = -rp;
+    }
+    return v3_add(v3_scale(node->s, rs * es), v3_scale(ax->p, rp * ep));
+}
+
+static inline lp_vec3 lp__node_transmit_real(const lp__node *node, const lp__axes *ax, double es,
+                                             double ep)
+{
+    return v3_add(v3_scale(node->s, node->f.ts * es), v3_scale(ax->p, node->f.tp * ep));
+}
+
 /* Power reflectance of the node in an unpolarized mode (fresnel or
  * schlick); 1 under TIR. */
 double lp__node_reflectance(const lp__node *node, lp_mode mode);

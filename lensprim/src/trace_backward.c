@@ -325,8 +325,28 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     return st;
 }
 
+/* A real field e through way node w in the direction of light, in real
+ * arithmetic (polarized mode): what way_step gives it.  0, e unchanged,
+ * where a field may turn complex or steer the node (TIR, normal
+ * incidence). */
+static int way_step_real(const bw_way *w, lp_vec3 *e, int *flip)
+{
+    const lp__node *nd = &w->node;
+    if (nd->normal || nd->f.tir)
+        return 0;
+    double es = v3_dot(*e, nd->s), ep = v3_dot(*e, nd->p);
+    *flip = 0;
+    if (w->reflect)
+        *e = lp__node_reflect_real(nd, &w->ax, es, ep, flip);
+    else
+        *e = lp__node_transmit_real(nd, &w->ax, es, ep);
+    return 1;
+}
+
 /* One bundle ray through the path of a query, in the direction of light:
- * it enters at `entry` (node k) and runs back through light[k-1..1]. */
+ * it enters at `entry` (node k) and runs back through light[k-1..1],
+ * where it reflects inside (j > 1) and refracts out (j = 1).  The field
+ * is kept real (e) as long as it stays real, then complex (E). */
 static lp_status gather_one(const lp_backward *bw, size_t qi, const bw_way *entry,
                             const bw_way *light, const lp_ray *b, lp_result *res,
                             lp_error *err)
@@ -343,26 +363,41 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const bw_way *entr
         return st0;
 
     double I0 = b->intensity;
-    lp__cvec3 E = cv3_real(vp, sqrt(I0));
+    lp_vec3 e = v3_scale(vp, sqrt(I0));
+    lp__cvec3 E = {0, 0, 0};
+    int real = mode == LP_MODE_POLARIZED;
+    if (!real)
+        E = cv3_real(e, 1.0);
     lp__payload pl = {o->lambda_nm, b->kphi, b->op + q->op, b->phase, b->ch};
     double absorbed = 0.0;
     res->in += I0;
 
-    /* Node k: the light reflects off the outside (k = 1) or refracts in
-     * (a refraction counts no jump: flip 0). */
-    way_step(entry, mode, &E, &br);
-    pl.kphi += br.flip;
-    E = br.E;
-    /* Nodes k-1..2 reflect it inside; node 1 refracts it out. */
-    for (int j = k - 1; j >= 1; j--) {
-        if (o->alpha > 0.0) {
-            absorbed += cv3_norm2(E) * bw->node[j].seg_abs;
-            E = cv3_scale_real(E, bw->node[j].seg_att);
+    for (int j = k; j >= 1; j--) {
+        const bw_way *w = j == k ? entry : &light[j];
+        int flip;
+        if (j < k && o->alpha > 0.0) { /* over the segment from node j + 1 */
+            const bw_node *nj = &bw->node[j];
+            if (real) {
+                absorbed += v3_dot(e, e) * nj->seg_abs;
+                e = v3_scale(e, nj->seg_att);
+            } else {
+                absorbed += cv3_norm2(E) * nj->seg_abs;
+                E = cv3_scale_real(E, nj->seg_att);
+            }
         }
-        way_step(&light[j], mode, &E, &br);
-        pl.kphi += br.flip;
-        E = br.E;
+        if (real && !way_step_real(w, &e, &flip)) {
+            real = 0;
+            E = cv3_real(e, 1.0);
+        }
+        if (!real) {
+            way_step(w, mode, &E, &br);
+            flip = br.flip;
+            E = br.E;
+        }
+        pl.kphi += flip;
     }
+    if (real)
+        E = cv3_real(e, 1.0);
     res->nodes += (size_t)k;
     return lp__emit_gathered(bw->lens, res, &E, &bw->exit, &pl, q, I0, absorbed, err);
 }
