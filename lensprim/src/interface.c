@@ -66,21 +66,21 @@ static lp__cvec3 combine(int real, double complex a, lp_vec3 u, double complex b
     return cv3_combine(a, u, b, w);
 }
 
-void lp__node_reflect_axes(const lp__node *node, lp__axes *ax)
+static inline void reflect_axes(const lp__node *node, lp__axes *ax)
 {
     ax->dir = v3_normalize(v3_madd(node->d, node->n, 2.0 * node->cos_i));
     ax->p = v3_cross(ax->dir, node->s);
 }
 
-void lp__node_transmit_axes(const lp__node *node, lp__axes *ax)
+static inline void transmit_axes(const lp__node *node, lp__axes *ax)
 {
     double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
     ax->dir = v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
     ax->p = v3_cross(ax->dir, node->s);
 }
 
-void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
-                         const lp__amp *amp, lp__branch *out)
+static inline void reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                              const lp__amp *amp, lp__branch *out)
 {
     lp_vec3 pr = ax->p;
     double complex es = amp->es, ep = amp->ep;
@@ -110,8 +110,8 @@ void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
     }
 }
 
-void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
-                          const lp__amp *amp, lp__branch *out)
+static inline void transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                               const lp__amp *amp, lp__branch *out)
 {
     lp_vec3 pt = ax->p;
     double complex es = amp->es, ep = amp->ep;
@@ -131,20 +131,42 @@ void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode
     }
 }
 
+void lp__node_reflect_axes(const lp__node *node, lp__axes *ax)
+{
+    reflect_axes(node, ax);
+}
+
+void lp__node_transmit_axes(const lp__node *node, lp__axes *ax)
+{
+    transmit_axes(node, ax);
+}
+
+void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                         const lp__amp *amp, lp__branch *out)
+{
+    reflect_on(node, ax, mode, amp, out);
+}
+
+void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                          const lp__amp *amp, lp__branch *out)
+{
+    transmit_on(node, ax, mode, amp, out);
+}
+
 void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
                           lp__branch *out)
 {
     lp__axes ax;
-    lp__node_reflect_axes(node, &ax);
-    lp__node_reflect_on(node, &ax, mode, amp, out);
+    reflect_axes(node, &ax);
+    reflect_on(node, &ax, mode, amp, out);
 }
 
 void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
                            lp__branch *out)
 {
     lp__axes ax;
-    lp__node_transmit_axes(node, &ax);
-    lp__node_transmit_on(node, &ax, mode, amp, out);
+    transmit_axes(node, &ax);
+    transmit_on(node, &ax, mode, amp, out);
 }
 
 void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp__branch *out)
