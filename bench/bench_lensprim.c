@@ -62,6 +62,7 @@ int main(int argc, char **argv)
 {
     size_t n = 200000;
     int only_mode = -1, only_depth = 0;
+    const char *only_column = NULL;
     lp_lens_desc desc;
     lp_lens *lens;
     lp_error err;
@@ -84,6 +85,8 @@ int main(int argc, char **argv)
                 fprintf(stderr, "bench: depth must be in 1..%d\n", LP_MAX_DEPTH);
                 return 2;
             }
+        } else if (strcmp(argv[i], "--column") == 0 && i + 1 < argc) {
+            only_column = argv[++i];
         } else if (argv[i][0] != '-' && strtoul(argv[i], NULL, 10) > 0) {
             n = strtoul(argv[i], NULL, 10);
         } else {
@@ -144,16 +147,18 @@ int main(int argc, char **argv)
             a.mode = (lp_mode)m;
             a.max_depth = only_depth ? only_depth : depths[di];
 
+#define RUN(name) (!only_column || strcmp(only_column, name) == 0)
             size_t nodes = 0;
             double t0 = now();
-            for (size_t i = 0; i < n; i++) {
+            for (size_t i = 0; i < n && RUN("fwd"); i++) {
                 lp_trace_forward(lens, &rays[i], &a, &res, NULL);
                 nodes += res.nodes;
             }
             double t_fwd = now() - t0;
 
             t0 = now();
-            lp_trace_forward_many(lens, rays, n, &a, &res, offsets, NULL);
+            if (RUN("batch"))
+                lp_trace_forward_many(lens, rays, n, &a, &res, offsets, NULL);
             double t_batch = now() - t0;
             size_t batch_nodes = res.nodes;
 
@@ -161,7 +166,7 @@ int main(int argc, char **argv)
              * groups of soa_group, each group at its first ray's lambda */
             size_t soa_nodes = 0;
             t0 = now();
-            for (size_t i = 0; i < n; i += soa_group) {
+            for (size_t i = 0; i < n && RUN("soa"); i += soa_group) {
                 size_t m = n - i < soa_group ? n - i : soa_group;
                 lp_ray_soa s = {sox + i, soy + i, soz + i, sdx + i, sdy + i, sdz + i, svx + i,
                                 svy + i, svz + i, sin_ + i, NULL, NULL, NULL, NULL};
@@ -172,7 +177,7 @@ int main(int argc, char **argv)
 
             size_t bnodes = 0;
             t0 = now();
-            for (size_t i = 0; i < n; i++) {
+            for (size_t i = 0; i < n && RUN("bwd"); i++) {
                 lp_backward_build(bw, lens, rays[i].origin, rays[i].dir, rays[i].lambda_nm, &a,
                                   NULL);
                 size_t nq = lp_backward_query_count(bw);
@@ -191,6 +196,37 @@ int main(int argc, char **argv)
             printf("%-10s %5d %14.3e %14.3e %14.3e %14.3e %10.3f\n", mode_name[m], a.max_depth,
                    nodes / t_fwd, batch_nodes / t_batch, soa_nodes / t_soa, bnodes / t_bwd,
                    t_pol > 0.0 ? t_fwd / t_pol : 1.0);
+            if (only_column)
+                printf("nodes: fwd %zu batch %zu soa %zu bwd %zu\n", nodes, batch_nodes, soa_nodes,
+                       bnodes);
+            /* one view ray at 16 wavelengths: 16 builds, or one call */
+            if (RUN("build16") || RUN("build16many")) {
+                enum { NW = 16 };
+                lp_backward *bws[NW];
+                double lam[NW];
+                for (int k = 0; k < NW; k++) {
+                    lp_backward_create(&bws[k], &err);
+                    lam[k] = 400.0 + 20.0 * k;
+                }
+                size_t views = n / 4;
+                t0 = now();
+                for (size_t i = 0; i < views && RUN("build16"); i++)
+                    for (int k = 0; k < NW; k++)
+                        lp_backward_build(bws[k], lens, rays[i].origin, rays[i].dir, lam[k], &a,
+                                          NULL);
+                double t_one = now() - t0;
+                t0 = now();
+                for (size_t i = 0; i < views; i++)
+                    lp_backward_build_many(bws, NW, lens, rays[i].origin, rays[i].dir, lam, &a,
+                                           NULL);
+                double t_many = now() - t0;
+                printf("build16: one view ray at 16 wavelengths: 16 builds %.3f us, "
+                       "lp_backward_build_many %.3f us (%.2fx)\n",
+                       1e6 * t_one / (double)views, 1e6 * t_many / (double)views,
+                       t_one / t_many);
+                for (int k = 0; k < NW; k++)
+                    lp_backward_destroy(bws[k]);
+            }
         }
     }
     lp_backward_destroy(bw);

@@ -25,14 +25,12 @@ cd "$(dirname "$0")/.."
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
-# The largest |a - b| over the float samples of two PFM files of one size
-# (the three header lines skipped; od prints the samples as floats).
+. scripts/pfm.sh
+
+# The largest |a - b| over the float samples of two PFM files of one size.
 largest_difference() {
-    head_bytes=$(head -n 3 "$1" | wc -c)
-    tail -c +"$((head_bytes + 1))" "$1" | od -An -v -f >"$tmp/a.txt"
-    tail -c +"$((head_bytes + 1))" "$2" | od -An -v -f >"$tmp/b.txt"
-    tr -s ' ' '\n' <"$tmp/a.txt" | sed '/^$/d' >"$tmp/a1.txt"
-    tr -s ' ' '\n' <"$tmp/b.txt" | sed '/^$/d' >"$tmp/b1.txt"
+    pfm_samples "$1" "$tmp/a1.txt"
+    pfm_samples "$2" "$tmp/b1.txt"
     paste "$tmp/a1.txt" "$tmp/b1.txt" | awk '
         $1 == $2 { next }
         $1 ~ /n/ || $2 ~ /n/ { odd = 1; next } # nan or inf on one side

@@ -561,6 +561,27 @@ LP_API lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens,
                                    double lambda_nm, const lp_trace_args *args,
                                    lp_error *err);
 
+/* Revision 2.  Phase 1 for one view ray at n wavelengths at once: the
+ * same as lp_backward_build(bw[k], lens, origin, dir, lambda_nm[k], args,
+ * err) for k = 0, 1, ..., n-1 in turn.  Each bw[k] ends holding exactly
+ * what that build leaves in it -- the same queries, bit for bit, the same
+ * rim depth, and the same results of every later lp_backward_gather -- and
+ * args->filter is called as those builds call it, wavelength by
+ * wavelength.  The view ray meets the lens at the same point at every
+ * wavelength; that hit is found once, and the chains inside, which
+ * differ with the wavelength, are traced side by side in loops over the
+ * wavelengths that the compiler vectorizes, so the call costs less than
+ * the n builds.  The first build that fails stops the call: its status is
+ * returned with lp_backward_build's message prefixed by "wavelength k: ",
+ * bw[k] is left as that build leaves it and bw[k+1 .. n) are not touched.
+ * A builder that appears twice holds the build of its last wavelength.
+ * n = 0 does nothing and returns LP_OK.  A NULL lens, or a NULL bw or
+ * lambda_nm when n > 0, gives LP_ERROR_INVALID_ARGUMENT before any build;
+ * a NULL bw[k] fails build k with LP_ERROR_INVALID_ARGUMENT. */
+LP_API lp_status lp_backward_build_many(lp_backward *const *bw, size_t n, const lp_lens *lens,
+                                        lp_vec3 origin, lp_vec3 dir, const double *lambda_nm,
+                                        const lp_trace_args *args, lp_error *err);
+
 LP_API size_t lp_backward_query_count(const lp_backward *bw);
 /* The query rays, count of them; valid until the next build. */
 LP_API const lp_query *lp_backward_queries(const lp_backward *bw);

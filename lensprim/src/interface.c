@@ -21,8 +21,7 @@ static lp_vec3 hint_axis(lp_vec3 d, const lp__cvec3 *hint)
     return v3_dot(e, e) > 0.0 ? v3_normalize(e) : v3_any_perp(d);
 }
 
-int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
-                   const lp__cvec3 *hint)
+int lp__node_setup_fresnel(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2)
 {
     double dn = v3_dot(d, normal);
     double adn = fabs(dn);
@@ -32,7 +31,13 @@ int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double 
     node->n = dn > 0.0 ? v3_neg(normal) : normal;
     node->cos_i = adn < 1.0 ? adn : 1.0;
     lp__fresnel_eval(node->cos_i, n1, n2, &node->f);
+    return node->f.tir;
+}
 
+int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
+                   const lp__cvec3 *hint)
+{
+    lp__node_setup_fresnel(node, d, normal, n1, n2);
     lp_vec3 s = v3_cross(d, node->n);
     double sl2 = v3_dot(s, s);
     node->normal = !(sl2 > 1e-18);
@@ -47,6 +52,17 @@ void lp__node_refit(lp__node *node, const lp__cvec3 *E)
         node->s = hint_axis(node->d, E);
         node->p = v3_cross(node->d, node->s);
     }
+}
+
+lp_vec3 lp__node_reflect_dir(const lp__node *node)
+{
+    return v3_normalize(v3_madd(node->d, node->n, 2.0 * node->cos_i));
+}
+
+lp_vec3 lp__node_transmit_dir(const lp__node *node)
+{
+    double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
+    return v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
 }
 
 double lp__node_reflectance(const lp__node *node, lp_mode mode)
@@ -68,14 +84,13 @@ static lp__cvec3 combine(int real, double complex a, lp_vec3 u, double complex b
 
 static inline void reflect_axes(const lp__node *node, lp__axes *ax)
 {
-    ax->dir = v3_normalize(v3_madd(node->d, node->n, 2.0 * node->cos_i));
+    ax->dir = lp__node_reflect_dir(node);
     ax->p = v3_cross(ax->dir, node->s);
 }
 
 static inline void transmit_axes(const lp__node *node, lp__axes *ax)
 {
-    double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
-    ax->dir = v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
+    ax->dir = lp__node_transmit_dir(node);
     ax->p = v3_cross(ax->dir, node->s);
 }
 

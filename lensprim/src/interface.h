@@ -48,6 +48,16 @@ typedef struct lp__node {
 int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
                    const lp__cvec3 *hint);
 
+/* The geometry and Fresnel factors of lp__node_setup alone (no s and p
+ * axes: for the directions and powers of the branches, not their
+ * fields).  Returns 1 under total internal reflection. */
+int lp__node_setup_fresnel(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2);
+
+/* The unit directions of the reflected and (not under TIR) transmitted
+ * branches: those of lp__node_reflect and lp__node_transmit. */
+lp_vec3 lp__node_reflect_dir(const lp__node *node);
+lp_vec3 lp__node_transmit_dir(const lp__node *node);
+
 /* A node set up once for any field (hint NULL) serves every field, except
  * at normal incidence, where the s axis follows the field: this redoes
  * the set-up for E then (node->normal), and is a no-op otherwise. */

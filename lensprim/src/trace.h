@@ -55,6 +55,11 @@ lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, cons
                    const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
                    lp_error *err);
 
+/* lp__emit for a field whose power cv3_norm2(*E) is known already. */
+lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, double power,
+                         const lp__exit *x, const lp__payload *pl, int depth, lp_kind kind,
+                         int surface, uint64_t path, lp_error *err);
+
 /* x wrapped into [-pi, pi] (x itself when it lies there already). */
 double lp__wrap_phase(double x);
 
@@ -107,6 +112,15 @@ lp_status lp__ray_check(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err
 
 /* Prefix the message in err with "ray i: " and return st (batch calls). */
 lp_status lp__ray_failed(lp_error *err, lp_status st, size_t i);
+
+/* Trace the records in[0..n) of one wavelength, whose optics are o, as
+ * lp_trace_forward_many does: offsets[base + i] = out->count before ray
+ * i, and an error names ray base + i.  *L is the lane engine's scratch
+ * (trace_lanes.h), made on first use; the caller destroys it. */
+struct lp__lanes;
+lp_status lp__trace_run(const lp_lens *lens, const lp__optics *o, const lp_trace_args *a,
+                        const lp_ray *in, size_t n, size_t base, lp_result *out, size_t *offsets,
+                        struct lp__lanes **L, lp_error *err);
 
 /* Trace a checked ray (lp__ray_check) at the optics o of its wavelength:
  * local origin p, local unit direction d, local unit field direction vp;

@@ -19,47 +19,9 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "backward.h"
 #include "error.h"
 #include "interface.h"
-#include "trace.h"
-#include "trace_crystal.h"
-
-typedef struct bw_node {
-    lp_vec3 p;       /* local point */
-    lp_vec3 n;       /* outward normal */
-    lp_vec3 e_out;   /* eye direction inside the glass leaving this node */
-    double seg;      /* length from this node to the next one */
-    double seg_att;  /* amplitude factor over seg: exp(-alpha seg / 2) */
-    double seg_abs;  /* power fraction absorbed over seg: 1 - seg_att^2 */
-    int surface;
-} bw_node;
-
-/* A node of the light's way back, for any field: the node and the axes
- * of the branch the light takes there. */
-typedef struct bw_way {
-    lp__node node;
-    lp__axes ax;
-    int reflect;     /* 1: it reflects there, 0: it refracts */
-} bw_way;
-
-struct lp_backward {
-    const lp_lens *lens;
-    lp_trace_args args;
-    lp__optics optics;
-    lp_vec3 view_dir;              /* local e_0 */
-    int n_nodes;
-    bw_node node[LP_MAX_DEPTH + 1]; /* node[1..n_nodes] */
-    size_t n_queries;
-    lp_query query[LP_MAX_DEPTH];
-    lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
-    lp__exit exit;                   /* where gathered light leaves */
-    int rim_depth;
-    unsigned warnings;
-    lp__xback *xb;                 /* the last build's, through a crystal */
-    int ways;                      /* 1: light and entry hold the gathers' ways */
-    bw_way light[LP_MAX_DEPTH];    /* light[j]: node j, arriving from inside */
-    bw_way entry[LP_MAX_DEPTH];    /* entry[q]: where query q's light enters */
-};
 
 lp_status lp_backward_create(lp_backward **out, lp_error *err)
 {
@@ -121,7 +83,7 @@ static double node_weight(const lp__node *nd, lp_mode mode, int reflect)
 
 /* The node where light answering query qi enters the lens (any field):
  * it reflects off the outside (depth 1) or refracts in. */
-static void entry_way(const lp_backward *bw, size_t qi, bw_way *w)
+static void entry_way(const lp_backward *bw, size_t qi, lp__bw_way *w)
 {
     const lp_query *q = &bw->query[qi];
     lp__node_setup(&w->node, v3_neg(bw->query_dir[qi]), bw->node[q->depth].n,
@@ -135,7 +97,7 @@ static void entry_way(const lp_backward *bw, size_t qi, bw_way *w)
 
 /* The node j of the way back, light arriving from inside (any field): it
  * reflects there (j > 1) or refracts out (j = 1). */
-static void light_way(const lp_backward *bw, int j, bw_way *w)
+static void light_way(const lp_backward *bw, int j, lp__bw_way *w)
 {
     lp__node_setup(&w->node, v3_neg(bw->node[j].e_out), bw->node[j].n, bw->optics.n_glass,
                    bw->optics.n_medium, NULL);
@@ -146,9 +108,11 @@ static void light_way(const lp_backward *bw, int j, bw_way *w)
         lp__node_transmit_axes(&w->node, &w->ax);
 }
 
-/* The ways of every query of the build, once for all its gathers. */
-static void set_up_ways(lp_backward *bw)
+/* The ways of every query of a polarized build (backward.h). */
+void lp__backward_built(lp_backward *bw)
 {
+    if (bw->args.mode != LP_MODE_POLARIZED || lp__xback_active(bw->xb))
+        return;
     int deepest = 0;
     for (size_t qi = 0; qi < bw->n_queries; qi++) {
         entry_way(bw, qi, &bw->entry[qi]);
@@ -161,7 +125,7 @@ static void set_up_ways(lp_backward *bw)
 }
 
 /* Field E through way node w in the direction of light, into *br. */
-static void way_step(const bw_way *w, lp_mode mode, const lp__cvec3 *E, lp__branch *br)
+static void way_step(const lp__bw_way *w, lp_mode mode, const lp__cvec3 *E, lp__branch *br)
 {
     if (w->node.normal) { /* the s axis follows the field: set up for it */
         lp__node nd = w->node;
@@ -180,18 +144,25 @@ static void way_step(const bw_way *w, lp_mode mode, const lp__cvec3 *E, lp__bran
         lp__node_transmit_on(&w->node, &w->ax, mode, &amp, br);
 }
 
-static void add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
-                      uint64_t path, double op, double bound, double weight)
+void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
+                            uint64_t path, double op, double bound, double weight)
+{
+    lp__backward_add_query_at(bw, depth, kind, surface, dir,
+                              lp__to_world_point(bw->lens, bw->node[depth].p),
+                              lp__to_world_dir(bw->lens, dir), path, op, bound, weight);
+}
+
+void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
+                               lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
+                               uint64_t path, double op, double bound, double weight)
 {
     lp_query *q = &bw->query[bw->n_queries];
-    lp_branch_info info;
+    lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
 
-    if (bound < bw->args.min_weight ||
-        !lp__branch_keep(bw->lens, &bw->args, depth, kind, surface, bw->node[depth].p, dir,
-                         bound, &info))
+    if (bound < bw->args.min_weight || !lp__args_keep(&bw->args, &info))
         return;
-    q->origin = info.origin;
-    q->dir = info.dir;
+    q->origin = world_origin;
+    q->dir = world_dir;
     q->depth = depth;
     q->kind = kind;
     q->surface = surface;
@@ -252,22 +223,19 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
     bw->node[1].p = h.p;
     bw->node[1].n = h.n;
     bw->node[1].surface = h.surface;
-    int tir = lp__node_setup(&nd, d, h.n, o->n_medium, o->n_glass, NULL);
-    lp__branch br;
-    lp__cvec3 zero = {0, 0, 0};
-    lp__node_reflect(&nd, mode, &zero, &br);
-    add_query(bw, 1, LP_KIND_REFLECT, h.surface, br.dir, 1u, 0.0, node_bound(&nd, mode, 1),
-              node_weight(&nd, mode, 1));
+    /* the branches' directions and powers (no fields) */
+    int tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_medium, o->n_glass);
+    lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, lp__node_reflect_dir(&nd), 1u, 0.0,
+                           node_bound(&nd, mode, 1), node_weight(&nd, mode, 1));
     if (tir) {
         lp__ok(err);
         return LP_OK;
     }
 
-    lp__node_transmit(&nd, mode, &zero, &br);
     double bound = node_bound(&nd, mode, 0), weight = node_weight(&nd, mode, 0), op = 0.0;
     uint64_t path = 0;
     int depth = 1;
-    d = br.dir;
+    d = lp__node_transmit_dir(&nd);
     p = h.p;
     int surface = h.surface;
     bw->node[1].e_out = d;
@@ -294,18 +262,17 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
         bw->node[depth].p = h.p;
         bw->node[depth].n = h.n;
         bw->node[depth].surface = h.surface;
-        tir = lp__node_setup(&nd, d, h.n, o->n_glass, o->n_medium, NULL);
-        if (!tir) {
-            lp__node_transmit(&nd, mode, &zero, &br);
-            add_query(bw, depth, h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
-                      h.surface, br.dir, path, op, bound * node_bound(&nd, mode, 0),
-                      weight * node_weight(&nd, mode, 0));
-        }
-        lp__node_reflect(&nd, mode, &zero, &br);
+        tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_glass, o->n_medium);
+        if (!tir)
+            lp__backward_add_query(bw, depth,
+                                   h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
+                                   h.surface, lp__node_transmit_dir(&nd), path, op,
+                                   bound * node_bound(&nd, mode, 0),
+                                   weight * node_weight(&nd, mode, 0));
         bound *= node_bound(&nd, mode, 1);
         weight *= node_weight(&nd, mode, 1);
         path |= (uint64_t)1 << (depth - 1);
-        d = br.dir;
+        d = lp__node_reflect_dir(&nd);
         p = h.p;
         surface = h.surface;
         bw->node[depth].e_out = d;
@@ -320,8 +287,8 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     if (bw)
         bw->ways = 0;
     lp_status st = build_chain(bw, lens, origin, dir, lambda_nm, args, err);
-    if (st == LP_OK && bw->args.mode == LP_MODE_POLARIZED && !lp__xback_active(bw->xb))
-        set_up_ways(bw);
+    if (st == LP_OK)
+        lp__backward_built(bw);
     return st;
 }
 
@@ -329,7 +296,7 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
  * arithmetic (polarized mode): what way_step gives it.  0, e unchanged,
  * where a field may turn complex or steer the node (TIR, normal
  * incidence). */
-static int way_step_real(const bw_way *w, lp_vec3 *e, int *flip)
+static int way_step_real(const lp__bw_way *w, lp_vec3 *e, int *flip)
 {
     const lp__node *nd = &w->node;
     if (nd->normal || nd->f.tir)
@@ -347,8 +314,8 @@ static int way_step_real(const bw_way *w, lp_vec3 *e, int *flip)
  * it enters at `entry` (node k) and runs back through light[k-1..1],
  * where it reflects inside (j > 1) and refracts out (j = 1).  The field
  * is kept real (e) as long as it stays real, then complex (E). */
-static lp_status gather_one(const lp_backward *bw, size_t qi, const bw_way *entry,
-                            const bw_way *light, const lp_ray *b, lp_result *res,
+static lp_status gather_one(const lp_backward *bw, size_t qi, const lp__bw_way *entry,
+                            const lp__bw_way *light, const lp_ray *b, lp_result *res,
                             lp_error *err)
 {
     const lp__optics *o = &bw->optics;
@@ -373,10 +340,10 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const bw_way *entr
     res->in += I0;
 
     for (int j = k; j >= 1; j--) {
-        const bw_way *w = j == k ? entry : &light[j];
+        const lp__bw_way *w = j == k ? entry : &light[j];
         int flip;
         if (j < k && o->alpha > 0.0) { /* over the segment from node j + 1 */
-            const bw_node *nj = &bw->node[j];
+            const lp__bw_node *nj = &bw->node[j];
             if (real) {
                 absorbed += v3_dot(e, e) * nj->seg_abs;
                 e = v3_scale(e, nj->seg_att);
@@ -415,8 +382,8 @@ lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bund
                         bw->n_queries);
     out->warnings |= bw->warnings;
     if (n > 0) {
-        const bw_way *entry = &bw->entry[q], *light = bw->light;
-        bw_way way[LP_MAX_DEPTH + 1]; /* this gather's own: way[k] the entry */
+        const lp__bw_way *entry = &bw->entry[q], *light = bw->light;
+        lp__bw_way way[LP_MAX_DEPTH + 1]; /* this gather's own: way[k] the entry */
         if (!bw->ways) {
             int k = bw->query[q].depth;
             entry_way(bw, q, &way[k]);

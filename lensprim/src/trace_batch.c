@@ -1,32 +1,47 @@
-/* trace_batch.c -- many rays of one wavelength given as arrays.
+/* trace_batch.c -- many rays of one wavelength: lp_trace_forward_soa, and
+ * the runs of one wavelength in lp_trace_forward_many.
  *
- * The wavelength's optics are computed once for the whole call.  The rays
- * are taken in blocks: one loop over the block, free of branches and
- * calls, normalizes every ray's direction and field direction, puts them
- * in the lens frame and prepares the bounding-sphere test; the compiler
- * vectorizes it across rays (this file is built with -fno-trapping-math,
- * which lets it compute the rejected cases' quotients and drop them; no
- * value changes).  Each ray is then traced by the one-ray code from the same
- * numbers, in order, so the result is the one lp_trace_forward_many gives
- * bit for bit. */
+ * The wavelength's optics are computed once.  The rays are taken in blocks
+ * of LP__LANES: one loop over the block, free of branches and calls,
+ * checks every ray, normalizes its direction and field direction, puts
+ * them in the lens frame and tests the lens's bounding sphere; the
+ * compiler vectorizes it across rays (this file is built with
+ * -fno-trapping-math, which lets it compute the rejected cases' quotients
+ * and drop them; no value changes).  The lane engine (trace_lanes.h) then
+ * traces the block's rays; each ray's results are added in order, and a
+ * ray the engine hands back (or refused by the check) is traced by the
+ * one-ray code from the same numbers, so the result is the one
+ * lp_trace_forward_many gives ray by ray, bit for bit. */
 #include <math.h>
+#include <string.h>
 
 #include "error.h"
 #include "trace.h"
+#include "trace_lanes.h"
 
-#define BLOCK 64
+#define BLOCK LP__LANES
 
-/* A block of rays, checked and in the lens frame. */
+/* A block of rays: its payload (0 where an optional array is absent), and
+ * the rays checked and in the lens frame. */
 typedef struct block {
+    double op[BLOCK], phase[BLOCK];
+    int kphi[BLOCK];
+    uint64_t ch[BLOCK];
     double px[BLOCK], py[BLOCK], pz[BLOCK]; /* local origin */
     double dx[BLOCK], dy[BLOCK], dz[BLOCK]; /* local unit direction */
     double vx[BLOCK], vy[BLOCK], vz[BLOCK]; /* local unit field direction */
-    double ok_vp[BLOCK];                    /* 1: the field direction is good */
-    double bb[BLOCK], cc[BLOCK];            /* the bounding-sphere test */
+    double good[BLOCK]; /* 1: valid (else the one-ray check words the error) */
+    double take[BLOCK]; /* 1: valid and reaching the bounding sphere */
 } block;
 
-/* Rays i0 .. i0+m of in into b: the one loop meant to be vectorized. */
-static void load_block(const lp_lens *lens, const lp_ray_soa *in, size_t i0, size_t m,
+/* isfinite, as a comparison the loop can vectorize */
+LP__INLINE int finite3(double x, double y, double z)
+{
+    return (fabs(x) <= DBL_MAX) & (fabs(y) <= DBL_MAX) & (fabs(z) <= DBL_MAX);
+}
+
+/* Rays i0 .. i0+m of in into b. */
+LP__WIDE static void load_block(const lp_lens *lens, const lp_ray_soa *in, size_t i0, size_t m,
                        block *restrict b)
 {
     const double *restrict ox = in->ox + i0, *restrict oy = in->oy + i0,
@@ -35,22 +50,35 @@ static void load_block(const lp_lens *lens, const lp_ray_soa *in, size_t i0, siz
                            *restrict dz = in->dz + i0;
     const double *restrict vx = in->vx + i0, *restrict vy = in->vy + i0,
                            *restrict vz = in->vz + i0;
+    const double *restrict intensity = in->intensity + i0;
     const lp_vec3 center = lens->bound_center;
     const double r2 = lens->bound_r2;
 
+    for (size_t j = 0; j < m; j++) {
+        b->op[j] = in->op ? in->op[i0 + j] : 0.0;
+        b->phase[j] = in->phase ? in->phase[i0 + j] : 0.0;
+        b->kphi[j] = in->kphi ? in->kphi[i0 + j] : 0;
+        b->ch[j] = in->ch ? in->ch[i0 + j] : 0;
+    }
+    /* the one loop meant to be vectorized */
     for (size_t j = 0; j < m; j++) {
         lp_vec3 o = v3(ox[j], oy[j], oz[j]);
         lp_vec3 dir = v3(dx[j], dy[j], dz[j]);
         lp_vec3 v = v3(vx[j], vy[j], vz[j]);
         lp_vec3 d = v3_normalize(dir);
-        double ok_vp;
+        double ok_vp, w = intensity[j];
         lp_vec3 vp = lp__perp_unit_core(v, d, &ok_vp);
-        b->ok_vp[j] = ok_vp;
+        /* lp__ray_check's tests */
+        int good = finite3(o.x, o.y, o.z) & finite3(dir.x, dir.y, dir.z) & (ok_vp != 0.0) &
+                   ((dir.x != 0.0) | (dir.y != 0.0) | (dir.z != 0.0)) &
+                   finite3(w, b->op[j], b->phase[j]) & (w >= 0.0) & finite3(v.x, v.y, v.z);
         /* the bounding sphere: outside it when cc > 0, then leaving it
          * when bb > 0, passing it by when bb^2 < cc */
         lp_vec3 oc = v3_sub(o, center);
-        b->bb[j] = v3_dot(oc, d);
-        b->cc[j] = v3_dot(oc, oc) - r2;
+        double bb = v3_dot(oc, d), cc = v3_dot(oc, oc) - r2;
+        int miss = (cc > 0.0) & ((bb > 0.0) | (bb * bb < cc));
+        b->good[j] = good ? 1.0 : 0.0;
+        b->take[j] = good & !miss ? 1.0 : 0.0;
         lp_vec3 p = lp__to_local_point(lens, o), dl = lp__to_local_dir(lens, d),
                 vl = lp__to_local_dir(lens, vp);
         b->px[j] = p.x;
@@ -65,45 +93,99 @@ static void load_block(const lp_lens *lens, const lp_ray_soa *in, size_t i0, siz
     }
 }
 
-/* Ray i of in as a one-ray input. */
-static lp_ray ray_at(const lp_ray_soa *in, size_t i, double lambda_nm)
+/* One ray of a block that the lane engine did not trace: by the one-ray
+ * code from the block's numbers, or (a ray the block's check refused) by
+ * the one-ray check, which words the error. */
+static lp_status trace_one_ray(const lp_lens *lens, const lp__optics *o, const lp_ray_soa *in,
+                               size_t i, const block *b, size_t j, const lp_trace_args *a,
+                               lp_result *out, lp_error *err)
 {
+    if (b->good[j] != 0.0 && b->take[j] == 0.0)
+        return LP_OK; /* misses the bounding sphere, so the lens */
     lp_ray r;
     r.origin = v3(in->ox[i], in->oy[i], in->oz[i]);
     r.dir = v3(in->dx[i], in->dy[i], in->dz[i]);
-    r.lambda_nm = lambda_nm;
+    r.lambda_nm = o->lambda_nm;
     r.intensity = in->intensity[i];
     r.vp = v3(in->vx[i], in->vy[i], in->vz[i]);
-    r.kphi = in->kphi ? in->kphi[i] : 0;
-    r.op = in->op ? in->op[i] : 0.0;
-    r.phase = in->phase ? in->phase[i] : 0.0;
-    r.ch = in->ch ? in->ch[i] : 0;
-    return r;
-}
-
-/* One ray of a block: checked by the block's numbers, or (a ray the
- * block's check refused) by the one-ray check, which words the error. */
-static lp_status trace_lane(const lp_lens *lens, const lp__optics *o, const lp_ray *r,
-                            const block *b, size_t j, const lp_trace_args *a, lp_result *out,
-                            lp_error *err)
-{
-    int good = v3_finite(r->origin) && v3_finite(r->dir) && b->ok_vp[j] != 0.0 &&
-               (r->dir.x != 0.0 || r->dir.y != 0.0 || r->dir.z != 0.0) &&
-               isfinite(r->intensity) && r->intensity >= 0.0 && isfinite(r->op) &&
-               isfinite(r->phase) && v3_finite(r->vp);
-    if (good) {
-        if (b->cc[j] > 0.0 && (b->bb[j] > 0.0 || b->bb[j] * b->bb[j] < b->cc[j]))
-            return LP_OK; /* misses the bounding sphere, so the lens */
-        return lp__trace_checked(lens, r, o, v3(b->px[j], b->py[j], b->pz[j]),
+    r.kphi = b->kphi[j];
+    r.op = b->op[j];
+    r.phase = b->phase[j];
+    r.ch = b->ch[j];
+    if (b->good[j] != 0.0)
+        return lp__trace_checked(lens, &r, o, v3(b->px[j], b->py[j], b->pz[j]),
                                  v3(b->dx[j], b->dy[j], b->dz[j]),
                                  v3(b->vx[j], b->vy[j], b->vz[j]), a, out, err);
-    }
     lp_vec3 d, vp;
-    lp_status st = lp__ray_check(r, &d, &vp, err);
+    lp_status st = lp__ray_check(&r, &d, &vp, err);
     if (st != LP_OK)
         return st;
-    return lp__trace_checked(lens, r, o, lp__to_local_point(lens, r->origin),
+    return lp__trace_checked(lens, &r, o, lp__to_local_point(lens, r.origin),
                              lp__to_local_dir(lens, d), lp__to_local_dir(lens, vp), a, out, err);
+}
+
+/* Rays 0..n of in at the optics o: offsets[base + i], and an error names
+ * ray base + i.  *L is the lane engine's scratch, made on first use (if
+ * that fails, every ray takes the one-ray code, with the same results). */
+static lp_status trace_arrays(const lp_lens *lens, const lp__optics *o, const lp_trace_args *a,
+                              const lp_ray_soa *in, size_t n, size_t base, lp_result *out,
+                              size_t *offsets, lp__lanes **L, lp_error *err)
+{
+    block b;
+    lp_status st;
+
+    if (!*L)
+        *L = lp__lanes_create(a->max_depth);
+    for (size_t i0 = 0; i0 < n; i0 += BLOCK) {
+        size_t m = n - i0 < BLOCK ? n - i0 : BLOCK;
+        load_block(lens, in, i0, m, &b);
+        if (*L) {
+            lp__lane_in li = {b.px, b.py, b.pz, b.dx, b.dy, b.dz, b.vx, b.vy, b.vz,
+                              in->intensity + i0, b.op, b.take};
+            lp__lanes_run(*L, lens, o, a, &li, m);
+        }
+        for (size_t j = 0; j < m; j++) {
+            size_t i = i0 + j;
+            offsets[base + i] = out->count;
+            if (*L && lp__lanes_traced(*L, j)) {
+                lp__payload pl = {o->lambda_nm, b.kphi[j], b.op[j], b.phase[j], b.ch[j]};
+                st = lp__lanes_emit(*L, j, lens, a, in->intensity[i], &pl, out, err);
+            } else {
+                st = trace_one_ray(lens, o, in, i, &b, j, a, out, err);
+            }
+            if (st != LP_OK)
+                return lp__ray_failed(err, st, base + i);
+        }
+    }
+    return LP_OK;
+}
+
+lp_status lp__trace_run(const lp_lens *lens, const lp__optics *o, const lp_trace_args *a,
+                        const lp_ray *in, size_t n, size_t base, lp_result *out, size_t *offsets,
+                        lp__lanes **L, lp_error *err)
+{
+    /* the records as arrays, a block at a time */
+    double ox[BLOCK], oy[BLOCK], oz[BLOCK], dx[BLOCK], dy[BLOCK], dz[BLOCK];
+    double vx[BLOCK], vy[BLOCK], vz[BLOCK], w[BLOCK], op[BLOCK], phase[BLOCK];
+    int kphi[BLOCK];
+    uint64_t ch[BLOCK];
+    lp_ray_soa s = {ox, oy, oz, dx, dy, dz, vx, vy, vz, w, op, phase, kphi, ch};
+    lp_status st;
+
+    for (size_t i0 = 0; i0 < n; i0 += BLOCK) {
+        size_t m = n - i0 < BLOCK ? n - i0 : BLOCK;
+        for (size_t j = 0; j < m; j++) {
+            const lp_ray *r = &in[i0 + j];
+            ox[j] = r->origin.x, oy[j] = r->origin.y, oz[j] = r->origin.z;
+            dx[j] = r->dir.x, dy[j] = r->dir.y, dz[j] = r->dir.z;
+            vx[j] = r->vp.x, vy[j] = r->vp.y, vz[j] = r->vp.z;
+            w[j] = r->intensity, op[j] = r->op, phase[j] = r->phase;
+            kphi[j] = r->kphi, ch[j] = r->ch;
+        }
+        if ((st = trace_arrays(lens, o, a, &s, m, base + i0, out, offsets, L, err)) != LP_OK)
+            return st;
+    }
+    return LP_OK;
 }
 
 lp_status lp_trace_forward_soa(const lp_lens *lens, double lambda_nm, const lp_ray_soa *in,
@@ -113,7 +195,6 @@ lp_status lp_trace_forward_soa(const lp_lens *lens, double lambda_nm, const lp_r
     lp_trace_args a;
     lp__optics o;
     lp_status st;
-    block b;
 
     if (!lens || !out || !offsets || (n > 0 && !in))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_trace_forward_soa: NULL argument");
@@ -126,17 +207,11 @@ lp_status lp_trace_forward_soa(const lp_lens *lens, double lambda_nm, const lp_r
         return st;
     if ((st = lp__optics_at(lens, lambda_nm, &o, err)) != LP_OK)
         return st;
-    for (size_t i0 = 0; i0 < n; i0 += BLOCK) {
-        size_t m = n - i0 < BLOCK ? n - i0 : BLOCK;
-        load_block(lens, in, i0, m, &b);
-        for (size_t j = 0; j < m; j++) {
-            size_t i = i0 + j;
-            lp_ray r = ray_at(in, i, lambda_nm);
-            offsets[i] = out->count;
-            if ((st = trace_lane(lens, &o, &r, &b, j, &a, out, err)) != LP_OK)
-                return lp__ray_failed(err, st, i);
-        }
-    }
+    lp__lanes *L = NULL;
+    st = trace_arrays(lens, &o, &a, in, n, 0, out, offsets, &L, err);
+    lp__lanes_destroy(L);
+    if (st != LP_OK)
+        return st;
     offsets[n] = out->count;
     lp__ok(err);
     return LP_OK;

@@ -101,10 +101,9 @@ double lp__wrap_phase(double x)
     return fabs(x) <= LP_PI ? x : remainder(x, 2.0 * LP_PI);
 }
 
-/* lp__emit for a field of power cv3_norm2(*E) known already. */
-static lp_status emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
-                            double power, const lp__exit *x, const lp__payload *pl, int depth,
-                            lp_kind kind, int surface, uint64_t path, lp_error *err)
+lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, double power,
+                         const lp__exit *x, const lp__payload *pl, int depth, lp_kind kind,
+                         int surface, uint64_t path, lp_error *err)
 {
     lp__linear_part part[2];
     int n = lp__field_split(E, power, x->d, part);
@@ -137,7 +136,7 @@ lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, cons
                    const lp__payload *pl, int depth, lp_kind kind, int surface, uint64_t path,
                    lp_error *err)
 {
-    return emit_power(lens, res, E, cv3_norm2(*E), x, pl, depth, kind, surface, path, err);
+    return lp__emit_power(lens, res, E, cv3_norm2(*E), x, pl, depth, kind, surface, path, err);
 }
 
 /* Send one outgoing field to the result, or count it as skipped. */
@@ -159,7 +158,7 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
         res->skipped += power;
         return LP_OK;
     }
-    return emit_power(lens, res, &b->E, power, &x, pl, depth, kind, surface, path, err);
+    return lp__emit_power(lens, res, &b->E, power, &x, pl, depth, kind, surface, path, err);
 }
 
 lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,

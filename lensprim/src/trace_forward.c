@@ -12,6 +12,7 @@
 #include "interface.h"
 #include "trace.h"
 #include "trace_crystal.h"
+#include "trace_lanes.h"
 
 lp_status lp__ray_check(const lp_ray *in, lp_vec3 *d, lp_vec3 *vp, lp_error *err)
 {
@@ -178,12 +179,16 @@ lp_status lp_trace_forward(const lp_lens *lens, const lp_ray *in, const lp_trace
     return LP_OK;
 }
 
+/* Runs of at least this many rays of one wavelength in
+ * lp_trace_forward_many are traced as arrays (trace_batch.c). */
+#define RUN_MIN 8
+
 lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in, size_t n,
                                 const lp_trace_args *args, lp_result *out, size_t *offsets,
                                 lp_error *err)
 {
     lp_trace_args a;
-    lp_status st;
+    lp_status st = LP_OK;
 
     if (!lens || (!in && n > 0) || !out || !offsets)
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_trace_forward_many: NULL argument");
@@ -192,11 +197,29 @@ lp_status lp_trace_forward_many(const lp_lens *lens, const lp_ray *in, size_t n,
         return st;
     lp__optics o; /* shared by consecutive rays of one wavelength */
     double o_valid = NAN;
-    for (size_t i = 0; i < n; i++) {
+    struct lp__lanes *L = NULL;
+    for (size_t i = 0; i < n && st == LP_OK;) {
+        size_t run = 1;
+        while (i + run < n && in[i + run].lambda_nm == in[i].lambda_nm)
+            run++;
+        if (run >= RUN_MIN) {
+            /* a run's optics, or (a bad wavelength) the ray by ray code
+             * below, which words the error at the ray where it arises */
+            lp__optics ro;
+            if (lp__optics_at(lens, in[i].lambda_nm, &ro, NULL) == LP_OK) {
+                st = lp__trace_run(lens, &ro, &a, in + i, run, i, out, offsets, &L, err);
+                i += run;
+                continue;
+            }
+        }
         offsets[i] = out->count;
         if ((st = trace_one(lens, &in[i], &a, &o, &o_valid, out, err)) != LP_OK)
-            return lp__ray_failed(err, st, i);
+            st = lp__ray_failed(err, st, i);
+        i++;
     }
+    lp__lanes_destroy(L);
+    if (st != LP_OK)
+        return st;
     offsets[n] = out->count;
     lp__ok(err);
     return LP_OK;

@@ -4,26 +4,24 @@
  *
  * ---- The spectral estimator ----------------------------------------------
  *
- * The integrator samples N stratified wavelengths over the band
- * [RS_LAMBDA_MIN, RS_LAMBDA_MAX] = [380, 780] nm (width 400 nm):
+ * The integrator samples N wavelengths lambda_i over the band
+ * [RS_LAMBDA_MIN, RS_LAMBDA_MAX] = [380, 780] nm (width 400 nm), the
+ * midpoints of N cells of widths w_i (quadrature.h: cells that keep out
+ * of the steps of Smits' spectra), traces one ray per wavelength and gets
+ * a spectral radiance L(lambda_i) at the camera that already includes the
+ * 1/K factor of the emitters (rs_spectrum_emission does).  Then
  *
- *     lambda_i = 380 + 400 (i + xi_i) / N,   i = 0..N-1, xi_i in [0,1)
+ *     XYZ = sum_i w_i L(lambda_i) cmf(lambda_i)
  *
- * traces one ray per wavelength and gets a spectral radiance L(lambda_i)
- * at the camera that already includes the 1/K factor of the emitters
- * (rs_spectrum_emission does).  Then
- *
- *     XYZ = (400 / N) * sum_i L(lambda_i) * cmf(lambda_i)
- *
- * i.e. rs_xyz_accumulate(xyz, L(lambda_i), lambda_i, 400.0 / N) for each i,
- * and the pixel is rs_xyz_to_linear_srgb(xyz).  This is an unbiased (for
- * jittered xi) estimate of the integral of L * cmf over 380-780 nm.  The
- * emitters are normalised over the same band, so an RGB emitter of colour
- * (1,1,1) seen directly gives XYZ = D65 white (0.9504, 1, 1.0886) and
- * linear sRGB (1,1,1) to within 1e-3.
+ * i.e. rs_xyz_accumulate(xyz, L(lambda_i), lambda_i, w_i) for each i, and
+ * the pixel is rs_xyz_to_linear_srgb(xyz): the midpoint rule for the
+ * integral of L * cmf over 380-780 nm.  The emitters are normalised over
+ * the same band, so an RGB emitter of colour (1,1,1) seen directly gives
+ * XYZ = D65 white (0.9504, 1, 1.0886) and linear sRGB (1,1,1) to within
+ * 1e-3 (exactly, after the integrator's colour correction).
  *
  * Monochromatic (LINE) emitters are deltas: they are not sampled by the
- * stratified wavelengths (rs_spectrum_emission returns 0 for them); the
+ * N wavelengths (rs_spectrum_emission returns 0 for them); the
  * integrator traces one extra ray at line_nm with unit weight and adds
  *
  *     XYZ += T(line_nm) * rs_spectrum_line_xyz(light)

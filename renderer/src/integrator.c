@@ -43,6 +43,7 @@
 #include "coherence.h"
 #include "integrator.h"
 #include "packet.h"
+#include "quadrature.h"
 #include "shapes.h"
 #include "emitter.h"
 #include "support/vec.h"
@@ -57,6 +58,7 @@ typedef struct band {
     double lambda;  /* continuum/line: the wavelength; rgb: the channel's */
     int light;      /* BAND_LINE: the light */
     int channel;    /* BAND_RGB */
+    double weight;  /* BAND_CONTINUUM: its cell's width, nm (quadrature.h) */
 } band;
 
 /* Rays of the polarized mode.  A packet's bundle holds every lane's rays:
@@ -102,7 +104,8 @@ struct rs_integrator {
                                    source or a crystal lens */
     double *lane_xyz;           /* [lane * 3 + c]: what one unit of the lane's
                                    value adds to the pixel's XYZ (a continuum
-                                   wavelength's CIE value, a line's XYZ) */
+                                   wavelength's CIE value times its cell's
+                                   width, a line's XYZ) */
 };
 
 /* What a colour is in each lane (band_emission or band_reflectance of
@@ -247,15 +250,22 @@ static int make_lanes(rs_integrator *it)
     it->n_lanes = n;
     if (it->opts.mode == RS_MODE_RGB) {
         for (int c = 0; c < 3; c++)
-            it->lanes[c] = (band){BAND_RGB, RS_RGB_LAMBDA[c], -1, c};
+            it->lanes[c] = (band){BAND_RGB, RS_RGB_LAMBDA[c], -1, c, 0.0};
     } else {
         int m = it->opts.wavelengths, k = 0;
-        double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / m;
+        double *weight = calloc((size_t)m, sizeof *weight);
+        if (!weight) {
+            free(lambda);
+            return -1;
+        }
+        rs_quadrature(m, lambda, weight);
         for (; k < m; k++)
-            it->lanes[k] = (band){BAND_CONTINUUM, RS_LAMBDA_MIN + dl * (k + 0.5), -1, -1};
+            it->lanes[k] = (band){BAND_CONTINUUM, lambda[k], -1, -1, weight[k]};
+        free(weight);
         for (size_t l = 0; l < sc->n_lights; l++)
             if (sc->lights[l].spectrum.type == RS_SPECTRUM_LINE)
-                it->lanes[k++] = (band){BAND_LINE, sc->lights[l].spectrum.line_nm, (int)l, -1};
+                it->lanes[k++] =
+                    (band){BAND_LINE, sc->lights[l].spectrum.line_nm, (int)l, -1, 0.0};
     }
     for (int k = 0; k < n; k++)
         lambda[k] = it->lanes[k].lambda;
@@ -305,34 +315,44 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
         it->light_norm[k] = rs_spectrum_norm(&ls);
         it->light_rgb[k] = light_colour(&ls, it->light_norm[k]);
     }
-    /* The N wavelengths are the midpoints of N equal bands over 380-780 nm
-     * (no jitter: no noise, the same for every pixel).  Emitter spectra
-     * are linear in their RGB (rs_emission_shape), so the colour error of
-     * this quadrature is one 3x3 matrix C: column k is the linear sRGB the
+    /* The N wavelengths are the midpoints of N cells over 380-780 nm that
+     * keep out of the steps of Smits' spectra (quadrature.h; no jitter: no
+     * noise, the same for every pixel).  Emitter spectra are linear in
+     * their RGB (rs_emission_shape), so the colour error of this
+     * quadrature is one 3x3 matrix C: column k is the linear sRGB the
      * quadrature gives the unit emitter of channel k.  Pixels are
      * multiplied by C^-1, and every RGB emitter seen directly or through
      * clear glass renders as exactly its RGB, white included. */
     {
         double C[3][3], cmf[3];
         int n = it->opts.wavelengths;
-        double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
+        double *node = calloc((size_t)n, sizeof *node), *width = calloc((size_t)n, sizeof *width);
+        if (!node || !width) {
+            free(node);
+            free(width);
+            rs_integrator_destroy(it);
+            snprintf(msg, msg_size, "out of memory");
+            return -1;
+        }
+        rs_quadrature(n, node, width);
         for (int k = 0; k < 3; k++) {
             rs_color unit = {k == 0, k == 1, k == 2};
             rs_spectrum us = {RS_SPECTRUM_RGB, unit, 0.0, 0.0};
             double xyz[3] = {0, 0, 0};
             rs_color rgb;
             for (int m = 0; m < n; m++) {
-                double lambda = RS_LAMBDA_MIN + dl * (m + 0.5);
-                double e = rs_spectrum_emission(&us, lambda);
-                rs_cmf(lambda, cmf);
+                double e = rs_spectrum_emission(&us, node[m]);
+                rs_cmf(node[m], cmf);
                 for (int c = 0; c < 3; c++)
-                    xyz[c] += e * cmf[c] * dl;
+                    xyz[c] += e * cmf[c] * width[m];
             }
             rs_xyz_to_linear_srgb(xyz, &rgb);
             C[0][k] = rgb.r;
             C[1][k] = rgb.g;
             C[2][k] = rgb.b;
         }
+        free(node);
+        free(width);
         if (n < 3 || !invert3(C, it->correction)) {
             /* Fewer than three wavelengths cannot carry colour: render the
              * luminance as grey, scaled so that white is exactly 1. */
@@ -632,6 +652,8 @@ static int make_lane_tables(rs_integrator *it)
         const band *b = &it->lanes[i];
         if (b->kind == BAND_CONTINUUM) {
             rs_cmf(b->lambda, &it->lane_xyz[3 * i]);
+            for (int c = 0; c < 3; c++)
+                it->lane_xyz[3 * i + c] *= b->weight;
         } else {
             const rs_light *l = &it->scene->lights[b->light];
             rs_spectrum s = l->spectrum;
@@ -1744,12 +1766,9 @@ static void ray_colour(const rs_integrator *it, rs_worker *w, lp_vec3 o, lp_vec3
     }
     double xyz[3] = {0, 0, 0}, lines[3] = {0, 0, 0};
     int n = it->opts.wavelengths;
-    double dl = (RS_LAMBDA_MAX - RS_LAMBDA_MIN) / n;
-    for (int k = 0; k < n; k++) {
-        const double *cmf = &it->lane_xyz[3 * k];
+    for (int k = 0; k < n; k++)
         for (int c = 0; c < 3; c++)
-            xyz[c] += L[k] * cmf[c] * dl;
-    }
+            xyz[c] += L[k] * it->lane_xyz[3 * k + c];
     /* Lines are exact deltas: no quadrature, no correction. */
     for (int k = n; k < it->n_lanes; k++)
         for (int c = 0; c < 3; c++)

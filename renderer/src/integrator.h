@@ -3,11 +3,12 @@
  *
  * A pixel's value is linear sRGB (D65).  Wavelengths are in standard air
  * (as the CIE tables and glass catalogs give them).  Spectral modes sample
- * `wavelengths` wavelengths over 380-780 nm (the midpoints of equal bands:
- * noise-free, the same for every pixel) plus the line wavelengths of
- * monochromatic lights, weight them with the CIE 1931 2-degree observer to
- * XYZ (normalized so that a white emitter renders exactly white) and
- * convert to linear sRGB. */
+ * `wavelengths` wavelengths over 380-780 nm (the midpoints of cells that
+ * keep out of the steps of Smits' spectra, each weighted by its cell's
+ * width: quadrature.h; noise-free, the same for every pixel) plus the line
+ * wavelengths of monochromatic lights, weight them with the CIE 1931
+ * 2-degree observer to XYZ (normalized so that a white emitter renders
+ * exactly white) and convert to linear sRGB. */
 #ifndef RS_INTEGRATOR_H
 #define RS_INTEGRATOR_H
 

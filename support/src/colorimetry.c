@@ -550,16 +550,12 @@ static const double d65_table[] = {
 
 /* ---- Smits (1999), 10 bins of 34 nm over 380-720 nm --------------------- */
 
-#define SMITS_FIRST_NM 380.0
-#define SMITS_BIN_NM 34.0
-#define SMITS_BINS 10
-
 /* The published white spectrum is 1.0000 1.0000 0.9999 0.9993 0.9992
  * 0.9998 1.0000 1.0000 1.0000 1.0000; it is used as exactly 1 (colorimetry.h).
  * Rows in the order of the enum below. */
 enum { SM_CYAN, SM_MAGENTA, SM_YELLOW, SM_RED, SM_GREEN, SM_BLUE };
 
-static const double smits_basis[6][SMITS_BINS] = {
+static const double smits_basis[6][RS_SMITS_BINS] = {
     /* cyan */    {0.9710, 0.9426, 1.0007, 1.0007, 1.0007, 1.0007, 0.1564, 0.0000, 0.0000, 0.0000},
     /* magenta */ {1.0000, 1.0000, 0.9685, 0.2229, 0.0000, 0.0458, 0.8369, 1.0000, 1.0000, 0.9959},
     /* yellow */  {0.0001, 0.0000, 0.1088, 0.6651, 1.0000, 1.0000, 0.9996, 0.9586, 0.9685, 0.9840},
@@ -650,13 +646,13 @@ static int smits_bin(double lambda_nm)
     double t;
     int k;
 
-    if (!(lambda_nm >= SMITS_FIRST_NM))
+    if (!(lambda_nm >= RS_SMITS_FIRST_NM))
         return 0; /* also NaN */
-    t = (lambda_nm - SMITS_FIRST_NM) / SMITS_BIN_NM;
-    if (!(t < SMITS_BINS))
-        return SMITS_BINS - 1;
+    t = (lambda_nm - RS_SMITS_FIRST_NM) / RS_SMITS_BIN_NM;
+    if (!(t < RS_SMITS_BINS))
+        return RS_SMITS_BINS - 1;
     k = (int)t;
-    return k < SMITS_BINS - 1 ? k : SMITS_BINS - 1;
+    return k < RS_SMITS_BINS - 1 ? k : RS_SMITS_BINS - 1;
 }
 
 static double nonneg(double v)

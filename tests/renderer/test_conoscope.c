@@ -36,6 +36,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "mat3.h"
 #include "integrator.h"
 #include "parser.h"
 #include "scene.h"
@@ -209,18 +210,6 @@ static void rgb_to_xyz(rs_color c, double xyz[3])
     xyz[2] = 0.0193 * c.r + 0.1192 * c.g + 0.9505 * c.b;
 }
 
-static void invert3(const double a[3][3], double out[3][3])
-{
-    double det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) -
-                 a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
-                 a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            int i1 = (j + 1) % 3, i2 = (j + 2) % 3, j1 = (i + 1) % 3, j2 = (i + 2) % 3;
-            out[i][j] = (a[i1][j1] * a[i2][j2] - a[i1][j2] * a[i2][j1]) / det;
-        }
-}
-
 static void test_michel_levy(void)
 {
     static char t[4096];
@@ -247,7 +236,7 @@ static void test_michel_levy(void)
         C[1][k] = rgb.g;
         C[2][k] = rgb.b;
     }
-    invert3(C, Ci);
+    mat3_invert(C, Ci);
     for (size_t n = 0; n < sizeof R_nm / sizeof R_nm[0]; n++) {
         double d = R_nm[n] * 1e-6 / (NO - NE);
         char plate[512];

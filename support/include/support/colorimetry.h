@@ -54,6 +54,17 @@ typedef struct rs_color {
 #define RS_LAMBDA_MIN 380.0
 #define RS_LAMBDA_MAX 780.0
 
+/* Smits' bins: bin k covers [RS_SMITS_FIRST_NM + k RS_SMITS_BIN_NM,
+ * RS_SMITS_FIRST_NM + (k + 1) RS_SMITS_BIN_NM), k = 0 .. RS_SMITS_BINS - 1,
+ * nm; below the first bin its value holds, above the last bin (720 nm)
+ * the last one's.  Every RGB colour's spectrum (rs_reflectance,
+ * rs_emission_shape) is therefore constant on each of [380, 414), [414,
+ * 448) ... [652, 686) and [686, 780] and steps only at the 9 inner edges
+ * 414, 448 ... 686 nm (none at 720). */
+#define RS_SMITS_FIRST_NM 380.0
+#define RS_SMITS_BIN_NM 34.0
+#define RS_SMITS_BINS 10
+
 /* Where the colour-matching table is defined (0 outside), nm. */
 #define RS_CMF_MIN_NM 360.0
 #define RS_CMF_MAX_NM 830.0

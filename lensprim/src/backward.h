@@ -1,0 +1,68 @@
+/* backward.h -- what an lp_backward holds (internal): trace_backward.c
+ * builds one and gathers through it, backward_many.c builds many at once. */
+#ifndef LP_BACKWARD_H
+#define LP_BACKWARD_H
+
+#include "interface.h"
+#include "trace.h"
+#include "trace_crystal.h"
+
+/* A node of the view ray's chain. */
+typedef struct lp__bw_node {
+    lp_vec3 p;       /* local point */
+    lp_vec3 n;       /* outward normal */
+    lp_vec3 e_out;   /* eye direction inside the glass leaving this node */
+    double seg;      /* length from this node to the next one */
+    double seg_att;  /* amplitude factor over seg: exp(-alpha seg / 2) */
+    double seg_abs;  /* power fraction absorbed over seg: 1 - seg_att^2 */
+    int surface;
+} lp__bw_node;
+
+/* A node of the light's way back in a gather, for any field: the node
+ * and the axes of the branch the light takes there. */
+typedef struct lp__bw_way {
+    lp__node node;
+    lp__axes ax;
+    int reflect;     /* 1: it reflects there, 0: it refracts */
+} lp__bw_way;
+
+struct lp_backward {
+    const lp_lens *lens;
+    lp_trace_args args;
+    lp__optics optics;
+    lp_vec3 view_dir;              /* local e_0 */
+    int n_nodes;
+    lp__bw_node node[LP_MAX_DEPTH + 1]; /* node[1..n_nodes] */
+    size_t n_queries;
+    lp_query query[LP_MAX_DEPTH];
+    lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
+    lp__exit exit;                   /* where gathered light leaves */
+    int rim_depth;
+    unsigned warnings;
+    lp__xback *xb;                 /* the last build's, through a crystal */
+    /* The gathers' ways (trace_backward.c), set up once by a polarized
+     * build: ways is 0 until then (cleared as a build starts) */
+    int ways;
+    lp__bw_way light[LP_MAX_DEPTH]; /* light[j]: node j, light arriving from inside */
+    lp__bw_way entry[LP_MAX_DEPTH]; /* entry[q]: where query q's light enters */
+};
+
+/* Add the query of the given depth, kind and surface leaving node
+ * bw->node[depth] along the local direction dir, with the path's bound,
+ * weight, optical path and path bits, unless bw->args (min_weight against
+ * the bound, the flags, the filter) decline it. */
+void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
+                            uint64_t path, double op, double bound, double weight);
+
+/* The same with the query's world origin (of bw->node[depth].p) and world
+ * direction (of dir) given. */
+void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
+                               lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
+                               uint64_t path, double op, double bound, double weight);
+
+/* Once a build of bw is done: in the polarized mode, whose light comes
+ * only by gathering, set up the ways of every gather of its queries
+ * (not through a crystal). */
+void lp__backward_built(lp_backward *bw);
+
+#endif

@@ -1,0 +1,389 @@
+/* backward_many.c -- lp_backward_build_many: the backward chains of one
+ * view ray at many wavelengths, in lockstep.
+ *
+ * The view ray meets the lens at the same point whatever its wavelength:
+ * that hit is found once, by the one-ray code.  From there each
+ * wavelength refracts its own way, so each is a lane, and the lanes walk
+ * their chains node by node together, in loops over the lanes that the
+ * compiler vectorizes (lanes.h): the node's geometry and Fresnel factors,
+ * the path's bound and weight, the next hit.  Every formula is
+ * lp_backward_build's with its operations in the same order, so each
+ * lane's numbers are that build's at its wavelength, bit for bit; the
+ * rim tests of the lanes near the rim and the absorption's expm1 are the
+ * one-ray code's, lane by lane.  Each step writes its nodes straight into
+ * the lanes' lp_backward; the queries are made at the end, wavelength by
+ * wavelength in depth order (lp__backward_add_query_at: the flags and the
+ * filter are called in the order of lp_backward_build). */
+#include <math.h>
+#include <string.h>
+
+#include "backward.h"
+#include "error.h"
+#include "lanes.h"
+
+/* Wavelengths per group (16 is what a spectral renderer traces). */
+#define NW 16
+
+/* The lanes of a group: their optics, their chains, one step's numbers. */
+typedef struct wl_lanes {
+    double ng[NW], nm[NW], ha[NW]; /* indices, -alpha/2 */
+    double eta_in[NW], eta_out[NW];
+    double r0_in[NW], r0_out[NW];  /* Schlick's R0 */
+    double px[NW], py[NW], pz[NW]; /* the node the lane is at */
+    double dx[NW], dy[NW], dz[NW]; /* the eye's direction from it */
+    double surf[NW];
+    double bound[NW], weight[NW], op[NW];
+    double live[NW];
+    /* a step: the hit, the rim test's lanes, the absorption */
+    double t[NW], hs[NW], hx[NW], hy[NW], hz[NW], rim[NW], m[NW];
+    /* the node there: normal, the query's direction, bound and weight */
+    double nx[NW], ny[NW], nz[NW];
+    double qx[NW], qy[NW], qz[NW], qb[NW], qw[NW], tir[NW];
+    /* the query in the world: its origin (the node) and direction */
+    double wox[NW], woy[NW], woz[NW], wdx[NW], wdy[NW], wdz[NW];
+} wl_lanes;
+
+/* The bound and weight factors of a node (trace_backward.c's node_bound
+ * and node_weight) for the reflected and the transmitted branch. */
+LP__INLINE void factors(lp_mode mode, double r0, double n1, double n2, const lp__lane_node *g,
+                        double *bR, double *bT, double *wR, double *wT)
+{
+    double Rf = lp__lane_reflectance(0, 0.0, 0, g); /* Fresnel's */
+    if (mode == LP_MODE_POLARIZED) {
+        double Rs = g->rs * g->rs, Rp = g->rp * g->rp;
+        double gg = 2.0 * sqrt(g->a * g->b), ts = gg * g->is, tp = gg * g->ip;
+        double ts2 = ts * ts, tp2 = tp * tp;
+        *bR = g->tir ? 1.0 : lp__max(Rs, Rp);
+        *bT = g->tir ? 0.0 : lp__max(ts2, tp2);
+        *wR = Rf;
+        *wT = 1.0 - Rf;
+    } else {
+        double R = mode == LP_MODE_SCHLICK ? lp__lane_reflectance(1, r0, n1 > n2, g) : Rf;
+        *bR = *wR = R;
+        *bT = *wT = 1.0 - R;
+    }
+}
+
+/* Node 1 of every lane: the view ray enters at the point of the unit
+ * normal hn, along d; the reflected query and the refracted chain. */
+LP__INLINE void entry_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp, lp_mode mode,
+                           lp_vec3 d, lp_vec3 hn)
+{
+    const lp__lane_lens K = *Kp; /* local: the loads are safe to select */
+    for (size_t k = 0; k < n; k++) {
+        lp__lane_node g;
+        double bR, bT, wR, wT;
+        lp__lane_node_at(W->nm[k], W->ng[k], W->eta_in[k], d, hn, &g);
+        factors(mode, W->r0_in[k], W->nm[k], W->ng[k], &g, &bR, &bT, &wR, &wT);
+        lp_vec3 wd = lp__lane_world_dir(&K, g.r);
+        W->qx[k] = g.r.x;
+        W->qy[k] = g.r.y;
+        W->qz[k] = g.r.z;
+        W->wdx[k] = wd.x;
+        W->wdy[k] = wd.y;
+        W->wdz[k] = wd.z;
+        W->qb[k] = bR;
+        W->qw[k] = wR;
+        W->tir[k] = g.tir ? 1.0 : 0.0;
+        W->dx[k] = g.t.x;
+        W->dy[k] = g.t.y;
+        W->dz[k] = g.t.z;
+        W->bound[k] = bT;
+        W->weight[k] = wT;
+        W->op[k] = 0.0;
+        W->live[k] = g.tir ? 0.0 : 1.0;
+    }
+}
+
+/* The next hit of every lane still walking (the loop's condition of
+ * lp_backward_build), but for the rim of the lanes near it. */
+LP__INLINE void hit_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp,
+                         double min_weight)
+{
+    const lp__lane_lens K = *Kp; /* local: the loads are safe to select */
+    for (size_t k = 0; k < n; k++) {
+        lp_vec3 p = v3(W->px[k], W->py[k], W->pz[k]);
+        lp_vec3 d = v3(W->dx[k], W->dy[k], W->dz[k]);
+        int live = (W->live[k] != 0.0) & !(W->bound[k] < min_weight);
+        double t;
+        lp_vec3 x;
+        int rim;
+        double hs = lp__lane_hit_inside(&K, p, d, W->surf[k], &t, &x, &rim);
+        W->live[k] = live ? 1.0 : 0.0;
+        W->t[k] = t;
+        W->hs[k] = hs;
+        W->hx[k] = x.x;
+        W->hy[k] = x.y;
+        W->hz[k] = x.z;
+        W->rim[k] = rim & live ? 1.0 : 0.0;
+        W->m[k] = W->ha[k] * t;
+    }
+}
+
+/* The segment to the hit and the node there, for every lane that met a
+ * cap: the query's direction, bound and weight, the reflected chain. */
+LP__INLINE void node_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp, lp_mode mode)
+{
+    const lp__lane_lens K = *Kp;
+    for (size_t k = 0; k < n; k++) {
+        double m = W->m[k], t = W->t[k], hs = W->hs[k];
+        double att = (1.0 + m) * (1.0 + m);
+        double bound = W->bound[k] * att, weight = W->weight[k] * att;
+        W->op[k] = W->op[k] + W->ng[k] * t;
+        lp_vec3 x = v3(W->hx[k], W->hy[k], W->hz[k]);
+        lp_vec3 d = v3(W->dx[k], W->dy[k], W->dz[k]);
+        lp_vec3 nrm = lp__lane_cap_normal(&K, hs, x);
+        lp__lane_node g;
+        double bR, bT, wR, wT;
+        lp__lane_node_at(W->ng[k], W->nm[k], W->eta_out[k], d, nrm, &g);
+        factors(mode, W->r0_out[k], W->ng[k], W->nm[k], &g, &bR, &bT, &wR, &wT);
+        W->nx[k] = nrm.x;
+        W->ny[k] = nrm.y;
+        W->nz[k] = nrm.z;
+        lp_vec3 wo = lp__lane_world_point(&K, x), wd = lp__lane_world_dir(&K, g.t);
+        W->qx[k] = g.t.x;
+        W->qy[k] = g.t.y;
+        W->qz[k] = g.t.z;
+        W->wox[k] = wo.x;
+        W->woy[k] = wo.y;
+        W->woz[k] = wo.z;
+        W->wdx[k] = wd.x;
+        W->wdy[k] = wd.y;
+        W->wdz[k] = wd.z;
+        W->qb[k] = bound * bT;
+        W->qw[k] = weight * wT;
+        W->tir[k] = g.tir ? 1.0 : 0.0;
+        W->bound[k] = bound * bR;
+        W->weight[k] = weight * wR;
+        W->px[k] = x.x;
+        W->py[k] = x.y;
+        W->pz[k] = x.z;
+        W->dx[k] = g.r.x;
+        W->dy[k] = g.r.y;
+        W->dz[k] = g.r.z;
+        W->surf[k] = hs;
+    }
+}
+
+/* The vector loops, each in one copy per mode and vector width. */
+LP__WIDE static void entry_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K,
+                                  lp_mode mode, lp_vec3 d, lp_vec3 hn)
+{
+    switch (mode) {
+    case LP_MODE_POLARIZED: entry_step(W, n, K, LP_MODE_POLARIZED, d, hn); break;
+    case LP_MODE_FRESNEL: entry_step(W, n, K, LP_MODE_FRESNEL, d, hn); break;
+    default: entry_step(W, n, K, LP_MODE_SCHLICK, d, hn); break;
+    }
+}
+
+LP__WIDE static void hit_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K,
+                                double min_weight)
+{
+    hit_step(W, n, K, min_weight);
+}
+
+LP__WIDE static void node_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K,
+                                 lp_mode mode)
+{
+    switch (mode) {
+    case LP_MODE_POLARIZED: node_step(W, n, K, LP_MODE_POLARIZED); break;
+    case LP_MODE_FRESNEL: node_step(W, n, K, LP_MODE_FRESNEL); break;
+    default: node_step(W, n, K, LP_MODE_SCHLICK); break;
+    }
+}
+
+/* A query candidate of node `depth` (the transmitted branch; node 1's
+ * reflected one) of lane k, kept in the builder's own query slot
+ * depth - 1 until lp__backward_add_query_at makes the queries: so no
+ * scratch is needed. */
+static void keep_candidate(lp_backward *bw, int depth, const wl_lanes *W, size_t k, lp_vec3 wo)
+{
+    lp_query *q = &bw->query[depth - 1];
+    bw->query_dir[depth - 1] = v3(W->qx[k], W->qy[k], W->qz[k]);
+    q->origin = wo;
+    q->dir = v3(W->wdx[k], W->wdy[k], W->wdz[k]);
+    q->op = W->op[k];
+    q->bound = W->qb[k];
+    q->weight = W->qw[k];
+}
+
+/* Wavelengths k0 .. k0+n of a cap hit h of the view ray (local
+ * direction d): their chains, into bw[k0..]. */
+static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
+                        const lp__lane_lens *K, lp_vec3 d, const lp__local_hit *h)
+{
+    wl_lanes W;
+    const lp_trace_args *a = &bw[0]->args;
+    lp_mode mode = a->mode;
+    int entry = h->surface, max_depth = a->max_depth;
+    int cand[NW][LP_MAX_DEPTH + 1]; /* 1: node j of lane k has a candidate */
+
+    for (size_t k = 0; k < n; k++) {
+        const lp__optics *o = &bw[k]->optics;
+        W.ng[k] = o->n_glass;
+        W.nm[k] = o->n_medium;
+        W.ha[k] = -0.5 * o->alpha;
+        W.eta_in[k] = o->n_medium / o->n_glass;
+        W.eta_out[k] = o->n_glass / o->n_medium;
+        W.r0_in[k] = lp__lane_schlick_r0(o->n_medium, o->n_glass);
+        W.r0_out[k] = lp__lane_schlick_r0(o->n_glass, o->n_medium);
+        W.px[k] = h->p.x, W.py[k] = h->p.y, W.pz[k] = h->p.z;
+        W.surf[k] = h->surface;
+    }
+    entry_kernel(&W, n, K, mode, d, h->n);
+    lp__exit exit = lp__exit_at(lens, h->p, v3_neg(d));
+    lp_vec3 wo1 = lp__to_world_point(lens, h->p);
+    for (size_t k = 0; k < n; k++) {
+        lp_backward *b = bw[k];
+        b->exit = exit;
+        b->n_nodes = 1;
+        b->node[1].p = h->p;
+        b->node[1].n = h->n;
+        b->node[1].surface = h->surface;
+        b->node[1].e_out = v3(W.dx[k], W.dy[k], W.dz[k]);
+        keep_candidate(b, 1, &W, k, wo1);
+        cand[k][1] = 1;
+    }
+    /* the chains, a node per step */
+    for (int depth = 1; depth < max_depth; depth++) {
+        size_t live = 0;
+        hit_kernel(&W, n, K, a->min_weight);
+        for (size_t k = 0; k < n; k++) {
+            if (W.live[k] == 0.0)
+                continue;
+            live++;
+            double t;
+            lp_vec3 p = v3(W.px[k], W.py[k], W.pz[k]), dk = v3(W.dx[k], W.dy[k], W.dz[k]);
+            if (W.rim[k] != 0.0 && lp__rim_intersect(&K->r, p, dk, K->eps, W.t[k], &t)) {
+                W.t[k] = t;
+                W.hs[k] = LP_SURFACE_RIM;
+                lp_vec3 x = v3_madd(p, dk, t);
+                W.hx[k] = x.x, W.hy[k] = x.y, W.hz[k] = x.z;
+                W.m[k] = W.ha[k] * t;
+            }
+            W.m[k] = W.ha[k] < 0.0 ? expm1(W.m[k]) : 0.0;
+        }
+        if (live == 0)
+            break;
+        node_kernel(&W, n, K, mode);
+        for (size_t k = 0; k < n; k++) {
+            if (W.live[k] == 0.0)
+                continue;
+            lp_backward *b = bw[k];
+            if (W.hs[k] < 0.0) { /* the chain lost its way */
+                b->warnings |= LP_WARN_LEAK;
+                W.live[k] = 0.0;
+                continue;
+            }
+            double m = W.m[k];
+            b->node[depth].seg = W.t[k];
+            b->node[depth].seg_att = 1.0 + m;
+            b->node[depth].seg_abs = -m * (2.0 + m);
+            if (W.hs[k] == LP_SURFACE_RIM) {
+                b->rim_depth = depth + 1;
+                W.live[k] = 0.0;
+                continue;
+            }
+            lp__bw_node *nd = &b->node[depth + 1];
+            nd->p = v3(W.px[k], W.py[k], W.pz[k]);
+            nd->n = v3(W.nx[k], W.ny[k], W.nz[k]);
+            nd->surface = (int)W.hs[k];
+            nd->e_out = v3(W.dx[k], W.dy[k], W.dz[k]);
+            b->n_nodes = depth + 1;
+            cand[k][depth + 1] = W.tir[k] == 0.0;
+            if (cand[k][depth + 1])
+                keep_candidate(b, depth + 1, &W, k, v3(W.wox[k], W.woy[k], W.woz[k]));
+        }
+    }
+    /* the queries, wavelength by wavelength, in depth order */
+    for (size_t k = 0; k < n; k++) {
+        lp_backward *b = bw[k];
+        uint64_t path = 0;
+        for (int j = 1; j <= b->n_nodes; j++) {
+            if (cand[k][j]) {
+                lp_query q = b->query[j - 1];
+                lp_vec3 dir = b->query_dir[j - 1];
+                int surface = b->node[j].surface;
+                lp_kind kind = j == 1 || surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
+                lp__backward_add_query_at(b, j, kind, surface, dir, q.origin, q.dir,
+                                          j == 1 ? 1u : path, q.op, q.bound, q.weight);
+            }
+            if (j > 1)
+                path |= (uint64_t)1 << (j - 1);
+        }
+    }
+}
+
+lp_status lp_backward_build_many(lp_backward *const *bw, size_t n, const lp_lens *lens,
+                                 lp_vec3 origin, lp_vec3 dir, const double *lambda_nm,
+                                 const lp_trace_args *args, lp_error *err)
+{
+    lp_status st;
+    lp_trace_args a;
+    lp__local_hit h;
+
+    if (!lens || (n > 0 && (!bw || !lambda_nm)))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_build_many: NULL argument");
+    /* What fails alike at every wavelength, or is done otherwise: the
+     * builds one by one (the first fails, or each is the one-ray code's). */
+    int one_by_one = n == 0 || lens->desc.uniaxial || lp__args_resolve(args, &a, NULL) != LP_OK ||
+                     !v3_finite(origin) || !v3_finite(dir);
+    lp_vec3 dw = v3_normalize(dir);
+    one_by_one |= dw.x == 0.0 && dw.y == 0.0 && dw.z == 0.0;
+    for (size_t k = 0; k < n && !one_by_one; k++)
+        for (size_t i = 0; i <= k && !one_by_one; i++)
+            one_by_one = !bw[k] || (i < k && bw[i] == bw[k]); /* NULL or twice */
+    size_t ok = 0; /* the wavelengths before the first that fails */
+    if (!one_by_one) {
+        /* every builder as lp_backward_build sets it before its chain */
+        for (; ok < n; ok++) {
+            lp_backward *b = bw[ok];
+            b->lens = lens;
+            b->n_nodes = 0;
+            b->n_queries = 0;
+            b->rim_depth = 0;
+            b->warnings = 0;
+            b->args = a;
+            b->ways = 0;
+            lp__xback_deactivate(b->xb);
+            if (lp__optics_at(lens, lambda_nm[ok], &b->optics, NULL) != LP_OK)
+                break;
+            b->warnings = b->optics.warnings;
+            b->view_dir = lp__to_local_dir(lens, dw);
+        }
+        lp_vec3 p = lp__to_local_point(lens, origin), d = lp__to_local_dir(lens, dw);
+        if (ok > 0 && lp__lens_hit(lens, p, d, lp__lens_surface_at(lens, p), 0.0, INFINITY, &h)) {
+            if (h.surface == LP_SURFACE_RIM) {
+                for (size_t k = 0; k < ok; k++)
+                    bw[k]->rim_depth = 1;
+            } else {
+                lp__lane_lens K;
+                lp__lane_lens_of(&K, lens);
+                for (size_t k0 = 0; k0 < ok; k0 += NW)
+                    build_group(bw + k0, ok - k0 < NW ? ok - k0 : NW, lens, &K, d, &h);
+            }
+        }
+        for (size_t k = 0; k < ok; k++)
+            lp__backward_built(bw[k]);
+        if (ok == n) {
+            lp__ok(err);
+            return LP_OK;
+        }
+    }
+    /* the rest one by one, from the first that fails or from the start */
+    for (size_t k = ok; k < n; k++) {
+        if (!bw[k])
+            st = lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "NULL lp_backward");
+        else
+            st = lp_backward_build(bw[k], lens, origin, dir, lambda_nm[k], args, err);
+        if (st != LP_OK) {
+            if (err) {
+                lp_error e = *err;
+                lp__fail(err, st, "wavelength %zu: %s", k, e.message);
+            }
+            return st;
+        }
+    }
+    lp__ok(err);
+    return LP_OK;
+}
