@@ -137,7 +137,16 @@ typedef struct query_memo {
 } query_memo;
 
 typedef struct frame {
-    lp_backward *bw;
+    lp_backward *bw; /* the build of the sub-packet being traced: one of bws */
+    /* A lens hit's sub-packets (lens_builds): sub-packet s has the lanes
+     * sub_lane[sub_at[s] .. sub_at[s + 1]), at those positions sub_pos of
+     * the packet, its build in bws[s] where sub_ok[s] */
+    lp_backward **bws;
+    int n_bws;       /* builders created */
+    int *sub_at, *sub_lane, *sub_pos;
+    double *sub_lambda;
+    unsigned char *sub_ok;
+    int n_sub, sub_next;
     query_memo qm;
     bundle child;
     lp_result res;
@@ -429,7 +438,14 @@ void rs_worker_destroy(rs_worker *w)
     for (int f = 0; f < RS_MAX_FRAMES; f++) {
         if (!w->frames[f])
             continue;
-        lp_backward_destroy(w->frames[f]->bw);
+        for (int b = 0; b < w->frames[f]->n_bws; b++)
+            lp_backward_destroy(w->frames[f]->bws[b]);
+        free(w->frames[f]->bws);
+        free(w->frames[f]->sub_at);
+        free(w->frames[f]->sub_lane);
+        free(w->frames[f]->sub_pos);
+        free(w->frames[f]->sub_lambda);
+        free(w->frames[f]->sub_ok);
         free(w->frames[f]->child.r);
         free(w->frames[f]->child.lane);
         free(w->frames[f]->child.I);
@@ -488,9 +504,16 @@ static frame *get_frame(rs_worker *w, int f)
         fr->hs = calloc(w->it->scene->n_lights + 1, sizeof *fr->hs);
         fr->light_v = calloc(n, sizeof *fr->light_v);
         fr->light_got = calloc(n, 1);
+        fr->bws = calloc(n, sizeof *fr->bws);
+        fr->sub_at = calloc(n + 1, sizeof *fr->sub_at);
+        fr->sub_lane = calloc(n, sizeof *fr->sub_lane);
+        fr->sub_pos = calloc(n, sizeof *fr->sub_pos);
+        fr->sub_lambda = calloc(n, sizeof *fr->sub_lambda);
+        fr->sub_ok = calloc(n, 1);
         if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach || !fr->bad ||
-            !fr->cb || !fr->hs || !fr->light_v || !fr->light_got ||
-            lp_backward_create(&fr->bw, NULL) != LP_OK) {
+            !fr->cb || !fr->hs || !fr->light_v || !fr->light_got || !fr->bws || !fr->sub_at ||
+            !fr->sub_lane || !fr->sub_pos || !fr->sub_lambda || !fr->sub_ok ||
+            lp_backward_create(&fr->bws[0], NULL) != LP_OK) {
             free(fr->lane);
             free(fr->pos);
             free(fr->val);
@@ -502,9 +525,17 @@ static frame *get_frame(rs_worker *w, int f)
             free(fr->hs);
             free(fr->light_v);
             free(fr->light_got);
+            free(fr->bws);
+            free(fr->sub_at);
+            free(fr->sub_lane);
+            free(fr->sub_pos);
+            free(fr->sub_lambda);
+            free(fr->sub_ok);
             free(fr);
             return NULL;
         }
+        fr->bw = fr->bws[0];
+        fr->n_bws = 1;
         lp_result_init(&fr->res);
         w->frames[f] = fr;
     }
@@ -1047,22 +1078,55 @@ static int lens_args(const rs_integrator *it, int level, double weight, lp_trace
     return 1;
 }
 
-/* The next sub-packet of lane[0..n) at lens `object` (lanes of equal
- * optics there, rs_packet_next) whose backward trace along (o, d) builds:
- * its lanes in fr->lane, their positions in lane[] in fr->pos, the build
- * in fr->bw.  Returns how many lanes, 0 when every lane is done (fr->done
- * cleared by the caller first).  A sub-packet whose build fails sees
- * nothing. */
-static int lens_next(const rs_integrator *it, frame *fr, const rs_object *ob, int object,
-                     const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a)
+/* A lens hit of the packet lane[0..n) at lens `object` along (o, d): its
+ * sub-packets (lanes of equal optics there, rs_packet_next, in the
+ * frame's sub_ arrays) and their backward builds, made at once -- at a
+ * dispersive lens, one lp_backward_build_many for the sub-packets'
+ * wavelengths, each build exactly lp_backward_build's.  lens_next then
+ * hands them out in order.  Returns -1 when out of memory. */
+static int lens_builds(const rs_integrator *it, frame *fr, const rs_object *ob, int object,
+                       const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a)
 {
-    int m;
-    while ((m = rs_packet_next(it->classes, object, lane, n, fr->done, fr->pos)) > 0) {
+    int m, ns = 0, at = 0;
+    memset(fr->done, 0, (size_t)n);
+    while ((m = rs_packet_next(it->classes, object, lane, n, fr->done, fr->sub_pos + at)) > 0) {
+        if (ns == fr->n_bws) {
+            if (lp_backward_create(&fr->bws[ns], NULL) != LP_OK)
+                return -1;
+            fr->n_bws++;
+        }
+        fr->sub_at[ns] = at;
         for (int k = 0; k < m; k++)
-            fr->lane[k] = lane[fr->pos[k]];
-        if (lp_backward_build(fr->bw, ob->lens, o, d, it->lanes[fr->lane[0]].lambda, a, NULL) ==
-            LP_OK)
-            return m;
+            fr->sub_lane[at + k] = lane[fr->sub_pos[at + k]];
+        fr->sub_lambda[ns++] = it->lanes[fr->sub_lane[at]].lambda;
+        at += m;
+    }
+    fr->sub_at[ns] = at;
+    fr->n_sub = ns;
+    fr->sub_next = 0;
+    int all = ns > 1 && lp_backward_build_many(fr->bws, (size_t)ns, ob->lens, o, d,
+                                               fr->sub_lambda, a, NULL) == LP_OK;
+    /* else each alone, to know which build fails (a sub-packet whose
+     * build fails sees nothing) */
+    for (int s = 0; s < ns; s++)
+        fr->sub_ok[s] = all || lp_backward_build(fr->bws[s], ob->lens, o, d, fr->sub_lambda[s],
+                                                 a, NULL) == LP_OK;
+    return 0;
+}
+
+/* The next sub-packet of lens_builds whose build succeeded: its lanes in
+ * fr->lane, their positions in the packet in fr->pos, its build in
+ * fr->bw.  Returns how many lanes, 0 when no sub-packet is left. */
+static int lens_next(frame *fr)
+{
+    while (fr->sub_next < fr->n_sub) {
+        int s = fr->sub_next++, at = fr->sub_at[s], m = fr->sub_at[s + 1] - at;
+        if (!fr->sub_ok[s])
+            continue;
+        memcpy(fr->lane, fr->sub_lane + at, (size_t)m * sizeof *fr->lane);
+        memcpy(fr->pos, fr->sub_pos + at, (size_t)m * sizeof *fr->pos);
+        fr->bw = fr->bws[s];
+        return m;
     }
     return 0;
 }
@@ -1126,9 +1190,10 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
         lp_trace_args a;
         if (!fr || !lens_args(it, level, weight, &a))
             return;
-        memset(fr->done, 0, (size_t)n);
         fr->qm.valid = 0;
-        while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
+        if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a) != 0)
+            return;
+        while ((m = lens_next(fr)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             for (int k = 0; k < m; k++)
@@ -1605,9 +1670,10 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
         if (!lens_args(it, level, weight, &a))
             return;
         int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
-        memset(fr->done, 0, (size_t)n);
         fr->qm.valid = 0;
-        while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
+        if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a) != 0)
+            return;
+        while ((m = lens_next(fr)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             uint64_t hit_id = ++w->splits;
