@@ -431,44 +431,49 @@ rs_worker *rs_worker_create(const rs_integrator *it)
     return w;
 }
 
+/* Free a frame and all it holds (NULL: no-op). */
+static void frame_free(frame *fr)
+{
+    if (!fr)
+        return;
+    for (int b = 0; b < fr->n_bws; b++)
+        lp_backward_destroy(fr->bws[b]);
+    free(fr->bws);
+    free(fr->sub_at);
+    free(fr->sub_lane);
+    free(fr->sub_pos);
+    free(fr->sub_lambda);
+    free(fr->sub_ok);
+    free(fr->child.r);
+    free(fr->child.lane);
+    free(fr->child.I);
+    free(fr->child.has);
+    free(fr->g_of);
+    free(fr->g_ray);
+    free(fr->g_start);
+    free(fr->g_count);
+    free(fr->g_rays);
+    free(fr->bad);
+    free(fr->cb);
+    free(fr->hs);
+    free(fr->light_v);
+    free(fr->light_got);
+    lp_result_release(&fr->res);
+    free(fr->lane);
+    free(fr->pos);
+    free(fr->val);
+    free(fr->acc);
+    free(fr->done);
+    free(fr->reach);
+    free(fr);
+}
+
 void rs_worker_destroy(rs_worker *w)
 {
     if (!w)
         return;
-    for (int f = 0; f < RS_MAX_FRAMES; f++) {
-        if (!w->frames[f])
-            continue;
-        for (int b = 0; b < w->frames[f]->n_bws; b++)
-            lp_backward_destroy(w->frames[f]->bws[b]);
-        free(w->frames[f]->bws);
-        free(w->frames[f]->sub_at);
-        free(w->frames[f]->sub_lane);
-        free(w->frames[f]->sub_pos);
-        free(w->frames[f]->sub_lambda);
-        free(w->frames[f]->sub_ok);
-        free(w->frames[f]->child.r);
-        free(w->frames[f]->child.lane);
-        free(w->frames[f]->child.I);
-        free(w->frames[f]->child.has);
-        free(w->frames[f]->g_of);
-        free(w->frames[f]->g_ray);
-        free(w->frames[f]->g_start);
-        free(w->frames[f]->g_count);
-        free(w->frames[f]->g_rays);
-        free(w->frames[f]->bad);
-        free(w->frames[f]->cb);
-        free(w->frames[f]->hs);
-        free(w->frames[f]->light_v);
-        free(w->frames[f]->light_got);
-        lp_result_release(&w->frames[f]->res);
-        free(w->frames[f]->lane);
-        free(w->frames[f]->pos);
-        free(w->frames[f]->val);
-        free(w->frames[f]->acc);
-        free(w->frames[f]->done);
-        free(w->frames[f]->reach);
-        free(w->frames[f]);
-    }
+    for (int f = 0; f < RS_MAX_FRAMES; f++)
+        frame_free(w->frames[f]);
     free(w->lane_all);
     free(w->lane_value);
     free(w->lane_at);
@@ -514,24 +519,7 @@ static frame *get_frame(rs_worker *w, int f)
             !fr->cb || !fr->hs || !fr->light_v || !fr->light_got || !fr->bws || !fr->sub_at ||
             !fr->sub_lane || !fr->sub_pos || !fr->sub_lambda || !fr->sub_ok ||
             lp_backward_create(&fr->bws[0], NULL) != LP_OK) {
-            free(fr->lane);
-            free(fr->pos);
-            free(fr->val);
-            free(fr->acc);
-            free(fr->done);
-            free(fr->reach);
-            free(fr->bad);
-            free(fr->cb);
-            free(fr->hs);
-            free(fr->light_v);
-            free(fr->light_got);
-            free(fr->bws);
-            free(fr->sub_at);
-            free(fr->sub_lane);
-            free(fr->sub_pos);
-            free(fr->sub_lambda);
-            free(fr->sub_ok);
-            free(fr);
+            frame_free(fr);
             return NULL;
         }
         fr->bw = fr->bws[0];
