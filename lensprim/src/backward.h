@@ -3,6 +3,7 @@
 #ifndef LP_BACKWARD_H
 #define LP_BACKWARD_H
 
+#include "interface.h"
 #include "trace.h"
 #include "trace_crystal.h"
 
@@ -16,6 +17,14 @@ typedef struct lp__bw_node {
     double seg_abs;  /* power fraction absorbed over seg: 1 - seg_att^2 */
     int surface;
 } lp__bw_node;
+
+/* A node of the light's way back in a gather, for any field: the node
+ * and the axes of the branch the light takes there. */
+typedef struct lp__bw_way {
+    lp__node node;
+    lp__axes ax;
+    int reflect;     /* 1: it reflects there, 0: it refracts */
+} lp__bw_way;
 
 struct lp_backward {
     const lp_lens *lens;
@@ -31,6 +40,11 @@ struct lp_backward {
     int rim_depth;
     unsigned warnings;
     lp__xback *xb;                 /* the last build's, through a crystal */
+    /* The gathers' ways (trace_backward.c), set up once by a polarized
+     * build: ways is 0 until then (cleared as a build starts) */
+    int ways;
+    lp__bw_way light[LP_MAX_DEPTH]; /* light[j]: node j, light arriving from inside */
+    lp__bw_way entry[LP_MAX_DEPTH]; /* entry[q]: where query q's light enters */
 };
 
 /* Add the query of the given depth, kind and surface leaving node
@@ -45,5 +59,10 @@ void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surfac
 void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
                                lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
                                uint64_t path, double op, double bound, double weight);
+
+/* Once a build of bw is done: in the polarized mode, whose light comes
+ * only by gathering, set up the ways of every gather of its queries
+ * (not through a crystal). */
+void lp__backward_built(lp_backward *bw);
 
 #endif

@@ -344,6 +344,7 @@ lp_status lp_backward_build_many(lp_backward *const *bw, size_t n, const lp_lens
             b->rim_depth = 0;
             b->warnings = 0;
             b->args = a;
+            b->ways = 0;
             lp__xback_deactivate(b->xb);
             if (lp__optics_at(lens, lambda_nm[ok], &b->optics, NULL) != LP_OK)
                 break;
@@ -362,6 +363,8 @@ lp_status lp_backward_build_many(lp_backward *const *bw, size_t n, const lp_lens
                     build_group(bw + k0, ok - k0 < NW ? ok - k0 : NW, lens, &K, d, &h);
             }
         }
+        for (size_t k = 0; k < ok; k++)
+            lp__backward_built(bw[k]);
         if (ok == n) {
             lp__ok(err);
             return LP_OK;

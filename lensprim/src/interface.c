@@ -82,17 +82,33 @@ static lp__cvec3 combine(int real, double complex a, lp_vec3 u, double complex b
     return cv3_combine(a, u, b, w);
 }
 
-void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
-                          lp__branch *out)
+static inline void reflect_axes(const lp__node *node, lp__axes *ax)
 {
-    lp_vec3 r = lp__node_reflect_dir(node);
-    lp_vec3 pr = v3_cross(r, node->s);
+    ax->dir = lp__node_reflect_dir(node);
+    ax->p = v3_cross(ax->dir, node->s);
+}
+
+static inline void transmit_axes(const lp__node *node, lp__axes *ax)
+{
+    ax->dir = lp__node_transmit_dir(node);
+    ax->p = v3_cross(ax->dir, node->s);
+}
+
+static inline void reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                              const lp__amp *amp, lp__branch *out)
+{
+    lp_vec3 pr = ax->p;
     double complex es = amp->es, ep = amp->ep;
     int real = amp->real;
 
-    out->dir = r;
+    out->dir = ax->dir;
     out->flip = 0;
     if (mode == LP_MODE_POLARIZED) {
+        if (real && !node->f.tir) {
+            out->E = cv3_real(lp__node_reflect_real(node, ax, creal(es), creal(ep), &out->flip),
+                              1.0);
+            return;
+        }
         double complex rs = node->f.rs, rp = node->f.rp;
         double mirror = creal(rs) * (creal(es) * creal(es) + cimag(es) * cimag(es)) -
                         creal(rp) * (creal(ep) * creal(ep) + cimag(ep) * cimag(ep));
@@ -101,11 +117,7 @@ void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp
             rp = -rp;
             out->flip = 1;
         }
-        real = real && !node->f.tir;
-        if (real)
-            out->E = combine(1, creal(rs) * creal(es), node->s, creal(rp) * creal(ep), pr);
-        else
-            out->E = cv3_combine(rs * es, node->s, rp * ep, pr);
+        out->E = cv3_combine(rs * es, node->s, rp * ep, pr);
     } else {
         /* The mirror image of the field, scaled to the reflected power. */
         double k = sqrt(lp__node_reflectance(node, mode));
@@ -113,23 +125,63 @@ void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp
     }
 }
 
-void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
-                           lp__branch *out)
+static inline void transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                               const lp__amp *amp, lp__branch *out)
 {
-    lp_vec3 t = lp__node_transmit_dir(node);
-    lp_vec3 pt = v3_cross(t, node->s);
+    lp_vec3 pt = ax->p;
     double complex es = amp->es, ep = amp->ep;
     int real = amp->real;
 
-    out->dir = t;
+    out->dir = ax->dir;
     out->flip = 0;
     if (mode == LP_MODE_POLARIZED) {
-        out->E = combine(real, node->f.ts * es, node->s, node->f.tp * ep, pt);
+        if (real)
+            out->E = cv3_real(lp__node_transmit_real(node, ax, creal(es), creal(ep)), 1.0);
+        else
+            out->E = cv3_combine(node->f.ts * es, node->s, node->f.tp * ep, pt);
     } else {
         double T = 1.0 - lp__node_reflectance(node, mode);
         double k = sqrt(T > 0.0 ? T : 0.0);
         out->E = combine(real, k * es, node->s, k * ep, pt);
     }
+}
+
+void lp__node_reflect_axes(const lp__node *node, lp__axes *ax)
+{
+    reflect_axes(node, ax);
+}
+
+void lp__node_transmit_axes(const lp__node *node, lp__axes *ax)
+{
+    transmit_axes(node, ax);
+}
+
+void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                         const lp__amp *amp, lp__branch *out)
+{
+    reflect_on(node, ax, mode, amp, out);
+}
+
+void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                          const lp__amp *amp, lp__branch *out)
+{
+    transmit_on(node, ax, mode, amp, out);
+}
+
+void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
+                          lp__branch *out)
+{
+    lp__axes ax;
+    reflect_axes(node, &ax);
+    reflect_on(node, &ax, mode, amp, out);
+}
+
+void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
+                           lp__branch *out)
+{
+    lp__axes ax;
+    transmit_axes(node, &ax);
+    transmit_on(node, &ax, mode, amp, out);
 }
 
 void lp__node_reflect(const lp__node *node, lp_mode mode, const lp__cvec3 *E, lp__branch *out)

@@ -98,6 +98,49 @@ void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp
 void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *amp,
                            lp__branch *out);
 
+/* A branch's direction and the p axis of its wave (dir x s): what a
+ * branch of a node costs beyond its field.  They are the same for every
+ * field of a node not at normal incidence (there s, hence p, follows the
+ * field: lp__node_refit), so a node that serves many fields computes
+ * them once. */
+typedef struct lp__axes {
+    lp_vec3 dir;  /* unit */
+    lp_vec3 p;    /* dir x s */
+} lp__axes;
+
+void lp__node_reflect_axes(const lp__node *node, lp__axes *ax);
+void lp__node_transmit_axes(const lp__node *node, lp__axes *ax);
+
+/* The branches of G on axes computed for the node as it is: the same as
+ * lp__node_reflect_amp / lp__node_transmit_amp. */
+void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                         const lp__amp *amp, lp__branch *out);
+void lp__node_transmit_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
+                          const lp__amp *amp, lp__branch *out);
+
+/* The polarized branches of a real field (every field before a total
+ * internal reflection) projected on the node's axes as es, ep, at a node
+ * not under TIR, in real arithmetic: the real parts of what
+ * lp__node_reflect_on / lp__node_transmit_on give (their imaginary parts
+ * are 0), which use these.  *flip as lp__branch.flip. */
+static inline lp_vec3 lp__node_reflect_real(const lp__node *node, const lp__axes *ax, double es,
+                                            double ep, int *flip)
+{
+    double rs = creal(node->f.rs), rp = creal(node->f.rp);
+    *flip = rs * (es * es) - rp * (ep * ep) < 0.0;
+    if (*flip) {
+        rs = -rs;
+        rp = -rp;
+    }
+    return v3_add(v3_scale(node->s, rs * es), v3_scale(ax->p, rp * ep));
+}
+
+static inline lp_vec3 lp__node_transmit_real(const lp__node *node, const lp__axes *ax, double es,
+                                             double ep)
+{
+    return v3_add(v3_scale(node->s, node->f.ts * es), v3_scale(ax->p, node->f.tp * ep));
+}
+
 /* Power reflectance of the node in an unpolarized mode (fresnel or
  * schlick); 1 under TIR. */
 double lp__node_reflectance(const lp__node *node, lp_mode mode);

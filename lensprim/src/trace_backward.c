@@ -10,9 +10,12 @@
  * at each node G is applied in the direction of light: at node k the
  * light refracts in (or, k = 1, reflects off the outside), at nodes
  * k-1..2 it reflects inside, at node 1 it refracts out.  The nodes of the
- * light's way are set up once per gather call, for any field: every
- * bundle ray of the call runs through the same ones (only at normal
- * incidence does a node's s axis follow the field: lp__node_refit). */
+ * light's way, with the axes of the branch it takes at each, serve any
+ * field: every bundle ray runs through the same ones (only at normal
+ * incidence does a node's s axis follow the field: lp__node_refit).  A
+ * polarized build, whose light comes only by gathering, sets them up
+ * once for every gather of its queries; in the other modes, whose query
+ * weights are exact and seldom gathered, a gather sets up its own. */
 #include <math.h>
 #include <stdlib.h>
 
@@ -78,19 +81,67 @@ static double node_weight(const lp__node *nd, lp_mode mode, int reflect)
     return reflect ? R : 1.0 - R;
 }
 
-/* The node where light answering query qi enters the lens (any field). */
-static void query_node(const lp_backward *bw, size_t qi, lp__node *nd)
+/* The node where light answering query qi enters the lens (any field):
+ * it reflects off the outside (depth 1) or refracts in. */
+static void entry_way(const lp_backward *bw, size_t qi, lp__bw_way *w)
 {
     const lp_query *q = &bw->query[qi];
-    lp__node_setup(nd, v3_neg(bw->query_dir[qi]), bw->node[q->depth].n, bw->optics.n_medium,
-                   bw->optics.n_glass, NULL);
+    lp__node_setup(&w->node, v3_neg(bw->query_dir[qi]), bw->node[q->depth].n,
+                   bw->optics.n_medium, bw->optics.n_glass, NULL);
+    w->reflect = q->depth == 1;
+    if (w->reflect)
+        lp__node_reflect_axes(&w->node, &w->ax);
+    else
+        lp__node_transmit_axes(&w->node, &w->ax);
 }
 
-/* The node j of the way back, light arriving from inside (any field). */
-static void light_node(const lp_backward *bw, int j, lp__node *nd)
+/* The node j of the way back, light arriving from inside (any field): it
+ * reflects there (j > 1) or refracts out (j = 1). */
+static void light_way(const lp_backward *bw, int j, lp__bw_way *w)
 {
-    lp__node_setup(nd, v3_neg(bw->node[j].e_out), bw->node[j].n, bw->optics.n_glass,
+    lp__node_setup(&w->node, v3_neg(bw->node[j].e_out), bw->node[j].n, bw->optics.n_glass,
                    bw->optics.n_medium, NULL);
+    w->reflect = j > 1;
+    if (w->reflect)
+        lp__node_reflect_axes(&w->node, &w->ax);
+    else
+        lp__node_transmit_axes(&w->node, &w->ax);
+}
+
+/* The ways of every query of a polarized build (backward.h). */
+void lp__backward_built(lp_backward *bw)
+{
+    if (bw->args.mode != LP_MODE_POLARIZED || lp__xback_active(bw->xb))
+        return;
+    int deepest = 0;
+    for (size_t qi = 0; qi < bw->n_queries; qi++) {
+        entry_way(bw, qi, &bw->entry[qi]);
+        if (bw->query[qi].depth > deepest)
+            deepest = bw->query[qi].depth;
+    }
+    for (int j = 1; j < deepest; j++)
+        light_way(bw, j, &bw->light[j]);
+    bw->ways = 1;
+}
+
+/* Field E through way node w in the direction of light, into *br. */
+static void way_step(const lp__bw_way *w, lp_mode mode, const lp__cvec3 *E, lp__branch *br)
+{
+    if (w->node.normal) { /* the s axis follows the field: set up for it */
+        lp__node nd = w->node;
+        lp__node_refit(&nd, E);
+        if (w->reflect)
+            lp__node_reflect(&nd, mode, E, br);
+        else
+            lp__node_transmit(&nd, mode, E, br);
+        return;
+    }
+    lp__amp amp;
+    lp__node_project(&w->node, E, &amp);
+    if (w->reflect)
+        lp__node_reflect_on(&w->node, &w->ax, mode, &amp, br);
+    else
+        lp__node_transmit_on(&w->node, &w->ax, mode, &amp, br);
 }
 
 void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surface, lp_vec3 dir,
@@ -124,8 +175,8 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
     bw->n_queries++;
 }
 
-lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin, lp_vec3 dir,
-                            double lambda_nm, const lp_trace_args *args, lp_error *err)
+static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origin, lp_vec3 dir,
+                             double lambda_nm, const lp_trace_args *args, lp_error *err)
 {
     lp__local_hit h;
     lp__node nd;
@@ -230,55 +281,90 @@ lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin
     return LP_OK;
 }
 
-/* One bundle ray through the path of a query, in the direction of light;
- * way[k] is the query's entry node, way[1..k-1] the light nodes. */
-static lp_status gather_one(const lp_backward *bw, size_t qi, const lp__node *way,
-                            const lp_ray *b, lp_result *res, lp_error *err)
+lp_status lp_backward_build(lp_backward *bw, const lp_lens *lens, lp_vec3 origin, lp_vec3 dir,
+                            double lambda_nm, const lp_trace_args *args, lp_error *err)
+{
+    if (bw)
+        bw->ways = 0;
+    lp_status st = build_chain(bw, lens, origin, dir, lambda_nm, args, err);
+    if (st == LP_OK)
+        lp__backward_built(bw);
+    return st;
+}
+
+/* A real field e through way node w in the direction of light, in real
+ * arithmetic (polarized mode): what way_step gives it.  0, e unchanged,
+ * where a field may turn complex or steer the node (TIR, normal
+ * incidence). */
+static int way_step_real(const lp__bw_way *w, lp_vec3 *e, int *flip)
+{
+    const lp__node *nd = &w->node;
+    if (nd->normal || nd->f.tir)
+        return 0;
+    double es = v3_dot(*e, nd->s), ep = v3_dot(*e, nd->p);
+    *flip = 0;
+    if (w->reflect)
+        *e = lp__node_reflect_real(nd, &w->ax, es, ep, flip);
+    else
+        *e = lp__node_transmit_real(nd, &w->ax, es, ep);
+    return 1;
+}
+
+/* One bundle ray through the path of a query, in the direction of light:
+ * it enters at `entry` (node k) and runs back through light[k-1..1],
+ * where it reflects inside (j > 1) and refracts out (j = 1).  The field
+ * is kept real (e) as long as it stays real, then complex (E). */
+static lp_status gather_one(const lp_backward *bw, size_t qi, const lp__bw_way *entry,
+                            const lp__bw_way *light, const lp_ray *b, lp_result *res,
+                            lp_error *err)
 {
     const lp__optics *o = &bw->optics;
     const lp_query *q = &bw->query[qi];
     lp_mode mode = bw->args.mode;
-    lp__node nd;
     lp__branch br;
     lp_vec3 vp;
     int k = q->depth;
 
-    nd = way[k];
-    lp_status st0 = lp__bundle_ray_check(bw->lens, b, nd.d, &vp, err);
+    lp_status st0 = lp__bundle_ray_check(bw->lens, b, entry->node.d, &vp, err);
     if (st0 != LP_OK)
         return st0;
 
     double I0 = b->intensity;
-    lp__cvec3 E = cv3_real(vp, sqrt(I0));
+    lp_vec3 e = v3_scale(vp, sqrt(I0));
+    lp__cvec3 E = {0, 0, 0};
+    int real = mode == LP_MODE_POLARIZED;
+    if (!real)
+        E = cv3_real(e, 1.0);
     lp__payload pl = {o->lambda_nm, b->kphi, b->op + q->op, b->phase, b->ch};
     double absorbed = 0.0;
     res->in += I0;
 
-    /* Node k: the light reflects off the outside (k = 1) or refracts in. */
-    lp__node_refit(&nd, &E);
-    if (k == 1) {
-        lp__node_reflect(&nd, mode, &E, &br);
-        pl.kphi += br.flip;
-    } else {
-        lp__node_transmit(&nd, mode, &E, &br);
-    }
-    E = br.E;
-    /* Nodes k-1..2 reflect it inside; node 1 refracts it out. */
-    for (int j = k - 1; j >= 1; j--) {
-        if (o->alpha > 0.0) {
-            absorbed += cv3_norm2(E) * bw->node[j].seg_abs;
-            E = cv3_scale_real(E, bw->node[j].seg_att);
+    for (int j = k; j >= 1; j--) {
+        const lp__bw_way *w = j == k ? entry : &light[j];
+        int flip;
+        if (j < k && o->alpha > 0.0) { /* over the segment from node j + 1 */
+            const lp__bw_node *nj = &bw->node[j];
+            if (real) {
+                absorbed += v3_dot(e, e) * nj->seg_abs;
+                e = v3_scale(e, nj->seg_att);
+            } else {
+                absorbed += cv3_norm2(E) * nj->seg_abs;
+                E = cv3_scale_real(E, nj->seg_att);
+            }
         }
-        nd = way[j];
-        lp__node_refit(&nd, &E);
-        if (j > 1) {
-            lp__node_reflect(&nd, mode, &E, &br);
-            pl.kphi += br.flip;
-        } else {
-            lp__node_transmit(&nd, mode, &E, &br);
+        if (real && !way_step_real(w, &e, &flip)) {
+            real = 0;
+            E = cv3_real(e, 1.0);
         }
-        E = br.E;
+        if (!real) {
+            way_step(w, mode, &E, &br);
+            flip = br.flip;
+            E = br.E;
+        }
+        pl.kphi += flip;
     }
+    if (real)
+        E = cv3_real(e, 1.0);
     res->nodes += (size_t)k;
     return lp__emit_gathered(bw->lens, res, &E, &bw->exit, &pl, q, I0, absorbed, err);
 }
@@ -296,13 +382,18 @@ lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bund
                         bw->n_queries);
     out->warnings |= bw->warnings;
     if (n > 0) {
-        lp__node way[LP_MAX_DEPTH + 1];
-        int k = bw->query[q].depth;
-        query_node(bw, q, &way[k]);
-        for (int j = 1; j < k; j++)
-            light_node(bw, j, &way[j]);
+        const lp__bw_way *entry = &bw->entry[q], *light = bw->light;
+        lp__bw_way way[LP_MAX_DEPTH + 1]; /* this gather's own: way[k] the entry */
+        if (!bw->ways) {
+            int k = bw->query[q].depth;
+            entry_way(bw, q, &way[k]);
+            for (int j = 1; j < k; j++)
+                light_way(bw, j, &way[j]);
+            entry = &way[k];
+            light = way;
+        }
         for (size_t i = 0; i < n; i++)
-            if ((st = gather_one(bw, q, way, &bundle[i], out, err)) != LP_OK)
+            if ((st = gather_one(bw, q, entry, light, &bundle[i], out, err)) != LP_OK)
                 return st;
     }
     lp__ok(err);

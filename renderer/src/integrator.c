@@ -67,8 +67,9 @@ typedef struct band {
  * optics that differ only in its intensity: vector s = -1 - lane[i] gives
  * per lane whether the lane has the ray (has[s * nl + lane]) and its
  * intensity there (I[s * nl + lane]); r[i].intensity is that of its first
- * lane.  Each lane's rays, in bundle order, are those tracing the lane
- * alone would give, in that order. */
+ * lane.  Rays may share a vector (a vector is never changed once made).
+ * Each lane's rays, in bundle order, are those tracing the lane alone
+ * would give, in that order. */
 typedef struct bundle {
     lp_ray *r;
     int *lane;
@@ -136,7 +137,16 @@ typedef struct query_memo {
 } query_memo;
 
 typedef struct frame {
-    lp_backward *bw;
+    lp_backward *bw; /* the build of the sub-packet being traced: one of bws */
+    /* A lens hit's sub-packets (lens_builds): sub-packet s has the lanes
+     * sub_lane[sub_at[s] .. sub_at[s + 1]), at those positions sub_pos of
+     * the packet, its build in bws[s] where sub_ok[s] */
+    lp_backward **bws;
+    int n_bws;       /* builders created */
+    int *sub_at, *sub_lane, *sub_pos;
+    double *sub_lambda;
+    unsigned char *sub_ok;
+    int n_sub, sub_next;
     query_memo qm;
     bundle child;
     lp_result res;
@@ -152,10 +162,8 @@ typedef struct frame {
     unsigned char *done;
     double *reach;  /* per light: light_reach memo of one shaded point */
     double *cb, *hs; /* per light: shade_point's cosine terms and highlights */
-    /* collect: per source slot (object, ambient, lights) and lane position */
-    double *rad;
-    unsigned char *got;
-    int *first; /* per slot */
+    double *light_v; /* per lane: a light's radiance (shade_packet) */
+    unsigned char *light_got; /* per lane: whether the light adds any */
 } frame;
 
 struct rs_worker {
@@ -424,38 +432,49 @@ rs_worker *rs_worker_create(const rs_integrator *it)
     return w;
 }
 
+/* Free a frame and all it holds (NULL: no-op). */
+static void frame_free(frame *fr)
+{
+    if (!fr)
+        return;
+    for (int b = 0; b < fr->n_bws; b++)
+        lp_backward_destroy(fr->bws[b]);
+    free(fr->bws);
+    free(fr->sub_at);
+    free(fr->sub_lane);
+    free(fr->sub_pos);
+    free(fr->sub_lambda);
+    free(fr->sub_ok);
+    free(fr->child.r);
+    free(fr->child.lane);
+    free(fr->child.I);
+    free(fr->child.has);
+    free(fr->g_of);
+    free(fr->g_ray);
+    free(fr->g_start);
+    free(fr->g_count);
+    free(fr->g_rays);
+    free(fr->bad);
+    free(fr->cb);
+    free(fr->hs);
+    free(fr->light_v);
+    free(fr->light_got);
+    lp_result_release(&fr->res);
+    free(fr->lane);
+    free(fr->pos);
+    free(fr->val);
+    free(fr->acc);
+    free(fr->done);
+    free(fr->reach);
+    free(fr);
+}
+
 void rs_worker_destroy(rs_worker *w)
 {
     if (!w)
         return;
-    for (int f = 0; f < RS_MAX_FRAMES; f++) {
-        if (!w->frames[f])
-            continue;
-        lp_backward_destroy(w->frames[f]->bw);
-        free(w->frames[f]->child.r);
-        free(w->frames[f]->child.lane);
-        free(w->frames[f]->child.I);
-        free(w->frames[f]->child.has);
-        free(w->frames[f]->rad);
-        free(w->frames[f]->got);
-        free(w->frames[f]->first);
-        free(w->frames[f]->g_of);
-        free(w->frames[f]->g_ray);
-        free(w->frames[f]->g_start);
-        free(w->frames[f]->g_count);
-        free(w->frames[f]->g_rays);
-        free(w->frames[f]->bad);
-        free(w->frames[f]->cb);
-        free(w->frames[f]->hs);
-        lp_result_release(&w->frames[f]->res);
-        free(w->frames[f]->lane);
-        free(w->frames[f]->pos);
-        free(w->frames[f]->val);
-        free(w->frames[f]->acc);
-        free(w->frames[f]->done);
-        free(w->frames[f]->reach);
-        free(w->frames[f]);
-    }
+    for (int f = 0; f < RS_MAX_FRAMES; f++)
+        frame_free(w->frames[f]);
     free(w->lane_all);
     free(w->lane_value);
     free(w->lane_at);
@@ -489,27 +508,23 @@ static frame *get_frame(rs_worker *w, int f)
         fr->bad = calloc(n, 1);
         fr->cb = calloc(w->it->scene->n_lights + 1, sizeof *fr->cb);
         fr->hs = calloc(w->it->scene->n_lights + 1, sizeof *fr->hs);
-        fr->rad = calloc((w->it->scene->n_lights + 2) * n, sizeof *fr->rad);
-        fr->got = calloc((w->it->scene->n_lights + 2) * n, 1);
-        fr->first = calloc(w->it->scene->n_lights + 2, sizeof *fr->first);
+        fr->light_v = calloc(n, sizeof *fr->light_v);
+        fr->light_got = calloc(n, 1);
+        fr->bws = calloc(n, sizeof *fr->bws);
+        fr->sub_at = calloc(n + 1, sizeof *fr->sub_at);
+        fr->sub_lane = calloc(n, sizeof *fr->sub_lane);
+        fr->sub_pos = calloc(n, sizeof *fr->sub_pos);
+        fr->sub_lambda = calloc(n, sizeof *fr->sub_lambda);
+        fr->sub_ok = calloc(n, 1);
         if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach || !fr->bad ||
-            !fr->cb || !fr->hs || !fr->rad || !fr->got || !fr->first ||
-            lp_backward_create(&fr->bw, NULL) != LP_OK) {
-            free(fr->lane);
-            free(fr->pos);
-            free(fr->val);
-            free(fr->acc);
-            free(fr->done);
-            free(fr->reach);
-            free(fr->bad);
-            free(fr->cb);
-            free(fr->hs);
-            free(fr->rad);
-            free(fr->got);
-            free(fr->first);
-            free(fr);
+            !fr->cb || !fr->hs || !fr->light_v || !fr->light_got || !fr->bws || !fr->sub_at ||
+            !fr->sub_lane || !fr->sub_pos || !fr->sub_lambda || !fr->sub_ok ||
+            lp_backward_create(&fr->bws[0], NULL) != LP_OK) {
+            frame_free(fr);
             return NULL;
         }
+        fr->bw = fr->bws[0];
+        fr->n_bws = 1;
         lp_result_init(&fr->res);
         w->frames[f] = fr;
     }
@@ -1052,22 +1067,55 @@ static int lens_args(const rs_integrator *it, int level, double weight, lp_trace
     return 1;
 }
 
-/* The next sub-packet of lane[0..n) at lens `object` (lanes of equal
- * optics there, rs_packet_next) whose backward trace along (o, d) builds:
- * its lanes in fr->lane, their positions in lane[] in fr->pos, the build
- * in fr->bw.  Returns how many lanes, 0 when every lane is done (fr->done
- * cleared by the caller first).  A sub-packet whose build fails sees
- * nothing. */
-static int lens_next(const rs_integrator *it, frame *fr, const rs_object *ob, int object,
-                     const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a)
+/* A lens hit of the packet lane[0..n) at lens `object` along (o, d): its
+ * sub-packets (lanes of equal optics there, rs_packet_next, in the
+ * frame's sub_ arrays) and their backward builds, made at once -- at a
+ * dispersive lens, one lp_backward_build_many for the sub-packets'
+ * wavelengths, each build exactly lp_backward_build's.  lens_next then
+ * hands them out in order.  Returns -1 when out of memory. */
+static int lens_builds(const rs_integrator *it, frame *fr, const rs_object *ob, int object,
+                       const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a)
 {
-    int m;
-    while ((m = rs_packet_next(it->classes, object, lane, n, fr->done, fr->pos)) > 0) {
+    int m, ns = 0, at = 0;
+    memset(fr->done, 0, (size_t)n);
+    while ((m = rs_packet_next(it->classes, object, lane, n, fr->done, fr->sub_pos + at)) > 0) {
+        if (ns == fr->n_bws) {
+            if (lp_backward_create(&fr->bws[ns], NULL) != LP_OK)
+                return -1;
+            fr->n_bws++;
+        }
+        fr->sub_at[ns] = at;
         for (int k = 0; k < m; k++)
-            fr->lane[k] = lane[fr->pos[k]];
-        if (lp_backward_build(fr->bw, ob->lens, o, d, it->lanes[fr->lane[0]].lambda, a, NULL) ==
-            LP_OK)
-            return m;
+            fr->sub_lane[at + k] = lane[fr->sub_pos[at + k]];
+        fr->sub_lambda[ns++] = it->lanes[fr->sub_lane[at]].lambda;
+        at += m;
+    }
+    fr->sub_at[ns] = at;
+    fr->n_sub = ns;
+    fr->sub_next = 0;
+    int all = ns > 1 && lp_backward_build_many(fr->bws, (size_t)ns, ob->lens, o, d,
+                                               fr->sub_lambda, a, NULL) == LP_OK;
+    /* else each alone, to know which build fails (a sub-packet whose
+     * build fails sees nothing) */
+    for (int s = 0; s < ns; s++)
+        fr->sub_ok[s] = all || lp_backward_build(fr->bws[s], ob->lens, o, d, fr->sub_lambda[s],
+                                                 a, NULL) == LP_OK;
+    return 0;
+}
+
+/* The next sub-packet of lens_builds whose build succeeded: its lanes in
+ * fr->lane, their positions in the packet in fr->pos, its build in
+ * fr->bw.  Returns how many lanes, 0 when no sub-packet is left. */
+static int lens_next(frame *fr)
+{
+    while (fr->sub_next < fr->n_sub) {
+        int s = fr->sub_next++, at = fr->sub_at[s], m = fr->sub_at[s + 1] - at;
+        if (!fr->sub_ok[s])
+            continue;
+        memcpy(fr->lane, fr->sub_lane + at, (size_t)m * sizeof *fr->lane);
+        memcpy(fr->pos, fr->sub_pos + at, (size_t)m * sizeof *fr->pos);
+        fr->bw = fr->bws[s];
+        return m;
     }
     return 0;
 }
@@ -1133,9 +1181,10 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
         lp_trace_args a;
         if (!fr || !lens_args(it, level, weight, &a))
             return;
-        memset(fr->done, 0, (size_t)n);
         fr->qm.valid = 0;
-        while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
+        if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a) != 0)
+            return;
+        while ((m = lens_next(fr)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             w->work.builds += 1.0;
@@ -1241,96 +1290,65 @@ static void emit_halves(void *ctx, int source, double radiance)
     }
 }
 
-/* What the lanes lane[0..n) of a packet emit, per source slot (0: the
- * object's emission or the background, 1: ambient, 2 + k: light k, the
- * order shade() emits in) and lane position k: the radiance in
- * fr->rad[slot * n + k] where fr->got[slot * n + k] is set, the first
- * such position in fr->first[slot] (-1: none); to be sent as shared rays
- * (emit_shared). */
-static void collect_begin(const rs_integrator *it, frame *fr, int n)
+/* The pair of shared halves (emit_halves for several lanes at once) of
+ * one source for the lanes lane[0..n) that emit there: those with
+ * got[l] set (got NULL: those with v[l] != 0), l = lane[k], radiance
+ * v[l]; none when no lane emits.  Returns -1 when out of memory. */
+static int shared_halves(int nl, const emit_ctx *e, int source, const int *lane, int n,
+                         const double *v, const unsigned char *got)
 {
-    int n_slots = (int)it->scene->n_lights + 2;
-    memset(fr->got, 0, (size_t)n_slots * (size_t)n);
-    for (int slot = 0; slot < n_slots; slot++)
-        fr->first[slot] = -1;
+    bundle *out = e->out;
+    double *I;
+    unsigned char *has;
+    int k = 0;
+    while (k < n && !(got ? got[lane[k]] : v[lane[k]] != 0.0))
+        k++;
+    if (k == n)
+        return 0;
+    lp_ray *r = bundle_push_shared(out, nl, 1, &I, &has);
+    if (!r)
+        return -1;
+    half_ray(e, source, 0, r);
+    r->intensity = 0.5 * v[lane[k]];
+    for (; k < n; k++) {
+        int l = lane[k];
+        if (got ? got[l] : v[l] != 0.0) {
+            has[l] = 1;
+            I[l] = 0.5 * v[l];
+        }
+    }
+    /* the other half: the same lanes and intensities, the same vector */
+    double I0 = r->intensity;
+    if (!(r = bundle_push(out, -1 - (int)(out->ns - 1))))
+        return -1;
+    half_ray(e, source, 1, r);
+    r->intensity = I0;
+    return 0;
 }
 
-static void collect(frame *fr, int n, int slot, int k, double radiance)
-{
-    size_t at = (size_t)slot * (size_t)n + (size_t)k;
-    fr->rad[at] = radiance;
-    fr->got[at] = 1;
-    if (fr->first[slot] < 0)
-        fr->first[slot] = k;
-}
-
-/* shade() for every lane of a packet at once, into the slots (the same
- * values, emitted under the same conditions). */
-static void shade_packet(const rs_integrator *it, const int *lane, int n, shade_point *sp,
-                         frame *fr)
+/* shade() for every lane of lane[0..n) at once, as shared halves (each
+ * lane's rays the values shade() and emit_halves give it, in their
+ * order): source by source, emission (source0), ambient, then each
+ * light.  Returns -1 when out of memory. */
+static int shade_packet(const rs_integrator *it, const int *lane, int n, shade_point *sp,
+                        int source0, frame *fr, const emit_ctx *e)
 {
     const rs_scene *sc = it->scene;
     const rs_finish *f = &sp->h->surface->finish;
-    collect_begin(it, fr, n);
-    for (int k = 0; k < n; k++) {
-        size_t l = (size_t)lane[k];
-        double e = sp->emission[l];
-        if (e != 0.0)
-            collect(fr, n, 0, k, e);
-        double a = sp->ambient[l];
-        if (a != 0.0)
-            collect(fr, n, 1, k, a);
+    int nl = it->n_lanes;
+    if (shared_halves(nl, e, source0, lane, n, sp->emission, NULL) != 0 ||
+        shared_halves(nl, e, 0, lane, n, sp->ambient, NULL) != 0)
+        return -1;
+    for (size_t q = 0; q < sc->n_lights; q++) {
+        for (int k = 0; k < n; k++) {
+            size_t l = (size_t)lane[k];
+            double rho = sp->pigment[l] * f->diffuse;
+            fr->light_got[l] = lit(f, rho) && light_term(it, sp, rho, l, q, &fr->light_v[l]);
+        }
+        if (shared_halves(nl, e, src_light(it, (int)q), lane, n, fr->light_v, fr->light_got) != 0)
+            return -1;
     }
-    if (sc->n_lights == 0)
-        return;
-    for (int k = 0; k < n; k++) {
-        size_t l = (size_t)lane[k];
-        double rho = sp->pigment[l] * f->diffuse, v;
-        if (!lit(f, rho))
-            continue;
-        for (size_t q = 0; q < sc->n_lights; q++)
-            if (light_term(it, sp, rho, l, q, &v))
-                collect(fr, n, 2 + (int)q, k, v);
-    }
-}
-
-/* The halves of every source slot some lane of lane[0..n) emitted
- * (collect), as shared rays: slot by slot, each lane's rays in the order
- * emit_halves would give them. */
-static void emit_shared(const rs_integrator *it, frame *fr, const int *lane, int n, int source0,
-                        const emit_ctx *e)
-{
-    int nl = it->n_lanes, n_slots = (int)it->scene->n_lights + 2;
-    bundle *out = e->out;
-    for (int slot = 0; slot < n_slots; slot++) {
-        int first = fr->first[slot];
-        if (first < 0)
-            continue;
-        const double *rad = fr->rad + (size_t)slot * (size_t)n;
-        const unsigned char *got = fr->got + (size_t)slot * (size_t)n;
-        int source = slot == 0 ? source0 : slot == 1 ? 0 : slot; /* 2 + k: light k */
-        double *I;
-        unsigned char *has;
-        lp_ray *r = bundle_push_shared(out, nl, 1, &I, &has);
-        if (!r)
-            return;
-        half_ray(e, source, 0, r);
-        r->intensity = 0.5 * rad[first];
-        for (int k = first; k < n; k++)
-            if (got[k]) {
-                has[lane[k]] = 1;
-                I[lane[k]] = 0.5 * rad[k];
-            }
-        /* the other half: the same intensities (indices, since a push
-         * may move the vectors) */
-        size_t s0 = out->ns - 1;
-        if (!(r = bundle_push_shared(out, nl, 0, &I, &has)))
-            return;
-        half_ray(e, source, 1, r);
-        r->intensity = 0.5 * rad[first];
-        memcpy(has, out->has + s0 * (size_t)nl, (size_t)nl);
-        memcpy(I, out->I + s0 * (size_t)nl, (size_t)nl * sizeof *I);
-    }
+    return 0;
 }
 
 static void shift_op(bundle *out, size_t from, double dop)
@@ -1482,6 +1500,28 @@ static int gather_groups(frame *fr, size_t j, int batch, size_t n_g)
     return 0;
 }
 
+/* A gathered shared ray's vector: per lane k, the output gI of a group
+ * whose first ray had intensity I0 scaled to the lane's input cI[k],
+ * gI (cI[k] / I0), into Io and has; a lane without the ray, or failed
+ * (bad), gets +0.  A group with an output had 0 < I0 < inf, so the
+ * quotient is exactly 1 in a lane whose input is I0 and the lane gets gI
+ * itself.  Every lane in one pass, the lanes kept by a bit mask (no
+ * branch: it vectorizes). */
+static void scale_lanes(int nl, const double *restrict cI, const unsigned char *restrict ch,
+                        const unsigned char *restrict bad, double I0, double gI,
+                        double *restrict Io, unsigned char *restrict has)
+{
+    for (int k = 0; k < nl; k++) {
+        double v = gI * (cI[k] / I0);
+        unsigned char keep = ch[k] & (unsigned char)(bad[k] ^ 1);
+        uint64_t bits;
+        memcpy(&bits, &v, sizeof bits);
+        bits &= (uint64_t)0 - keep;
+        has[k] = keep;
+        memcpy(&Io[k], &bits, sizeof bits);
+    }
+}
+
 /* Gather the rays of fr->child (lanes of equal optics at this lens) along
  * query j, appending the outputs to out, each with its ray's lanes.
  * Rays that differ only in intensity (a shared ray's lanes, and rays of
@@ -1549,19 +1589,7 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
                 size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
                 if (!(r = bundle_push_shared(out, nl, 0, &Io, &has)))
                     return -1;
-                const unsigned char *ch = c->has + s;
-                const double *cI = c->I + s;
-                double gI = gr->intensity;
-                /* every lane in one pass (no branch: it vectorizes); a
-                 * lane without the ray, or failed, gets 0 */
-                for (int k = 0; k < nl; k++) {
-                    double I = cI[k];
-                    double scale = I == I0 ? 1.0 : I / I0;
-                    double v = scale != 1.0 ? gI * scale : gI;
-                    unsigned char keep = ch[k] & (unsigned char)(fr->bad[k] ^ 1);
-                    has[k] = keep;
-                    Io[k] = keep ? v : 0.0;
-                }
+                scale_lanes(nl, c->I + s, c->has + s, fr->bad, I0, gr->intensity, Io, has);
                 for (first = 0; first < nl && !has[first]; first++)
                     ;
                 if (first == nl) { /* every lane failed: no ray */
@@ -1607,25 +1635,21 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
     w->work.rays += 1.0;
     w->work.lane_rays += n;
     if (!hit) {
-        emit_ctx e = emit_ctx_make(out, d, -1);
-        frame *fr = n > 1 ? get_frame(w, f) : NULL;
-        if (fr)
-            collect_begin(it, fr, n);
-        for (int k = 0; k < n; k++) {
-            double L = it->lane_background[lane[k]];
-            if (L == 0.0)
-                continue;
-            if (e.wavelet < 0 && (e.wavelet = record_wavelet(w, o, d, NULL)) < 0)
-                return;
-            if (fr) {
-                collect(fr, n, 0, k, L);
-            } else {
-                e.lane = lane[k];
-                emit_halves(&e, 1, L);
-            }
+        const double *L = it->lane_background;
+        int k = 0;
+        while (k < n && L[lane[k]] == 0.0)
+            k++;
+        if (k == n)
+            return;
+        emit_ctx e = emit_ctx_make(out, d, record_wavelet(w, o, d, NULL));
+        if (e.wavelet < 0)
+            return;
+        if (n > 1) {
+            shared_halves(it->n_lanes, &e, 1, lane, n, L, NULL);
+        } else {
+            e.lane = lane[0];
+            emit_halves(&e, 1, L[lane[0]]);
         }
-        if (fr && e.wavelet >= 0)
-            emit_shared(it, fr, lane, n, 1, &e);
         return;
     }
     const rs_hit h = *hit;
@@ -1640,9 +1664,10 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
         if (!lens_args(it, level, weight, &a))
             return;
         int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
-        memset(fr->done, 0, (size_t)n);
         fr->qm.valid = 0;
-        while ((m = lens_next(it, fr, ob, h.object, lane, n, o, d, &a)) > 0) {
+        if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a) != 0)
+            return;
+        while ((m = lens_next(fr)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             uint64_t hit_id = ++w->splits;
@@ -1706,12 +1731,18 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
             e.lane = lane[0];
             shade(it, &it->lanes[lane[0]], &sp, emit_halves, &e);
         } else {
-            shade_packet(it, lane, n, &sp, fr);
-            emit_shared(it, fr, lane, n, src_object(it, h.object), &e);
+            shade_packet(it, lane, n, &sp, src_object(it, h.object), fr, &e);
         }
     }
     if (has_reflection(&ob->finish) && level < it->max_level && f + 1 < RS_MAX_FRAMES)
         mirror_pol(w, lane, n, ob, &h, d, level, weight, f, fr, out);
+}
+
+/* L[k] += I[k] for every lane (vectorized). */
+static void add_lanes(int nl, const double *restrict I, double *restrict L)
+{
+    for (int k = 0; k < nl; k++)
+        L[k] += I[k];
 }
 
 /* The polarized mode's power seen along a camera ray in every lane, into
@@ -1735,9 +1766,7 @@ static void pol_values(rs_worker *w, lp_vec3 o, lp_vec3 d, double *L)
             if (l >= 0) {
                 L[l] += p->r[i].intensity;
             } else { /* a lane without the ray adds 0 (bundle_push_shared) */
-                const double *I = p->I + (size_t)(-1 - l) * (size_t)nl;
-                for (int k = 0; k < nl; k++)
-                    L[k] += I[k];
+                add_lanes(nl, p->I + (size_t)(-1 - l) * (size_t)nl, L);
             }
         }
         for (int k = 0; k < nl; k++)
