@@ -5,6 +5,7 @@
 
 #include <ctype.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -445,6 +446,7 @@ typedef struct region_ctx {
     const rs_integrator *it;
     float *rgb;
     int x0, y0, w; /* the region's corner in the image and its width */
+    atomic_llong pixels, rays, lane_rays, builds, gathered; /* the tiles' work, summed */
 } region_ctx;
 
 static void *worker_make(void *user)
@@ -458,10 +460,13 @@ static void worker_free(void *worker)
     rs_worker_destroy(worker);
 }
 
-/* Tile (x0..x1, y0..y1) of the region, in region coordinates. */
+/* Tile (x0..x1, y0..y1) of the region, in region coordinates; its work
+ * (whole numbers) added to the region's. */
 static void render_tile(void *user, void *worker, int x0, int y0, int x1, int y1)
 {
-    const region_ctx *c = user;
+    region_ctx *c = user;
+    rs_work before, after;
+    rs_worker_work(worker, &before);
     for (int j = y0; j < y1; j++)
         for (int i = x0; i < x1; i++) {
             rs_color col;
@@ -471,13 +476,22 @@ static void render_tile(void *user, void *worker, int x0, int y0, int x1, int y1
             px[1] = (float)col.g;
             px[2] = (float)col.b;
         }
+    rs_worker_work(worker, &after);
+    atomic_fetch_add(&c->pixels, (long long)(x1 - x0) * (y1 - y0));
+    atomic_fetch_add(&c->rays, (long long)(after.rays - before.rays));
+    atomic_fetch_add(&c->lane_rays, (long long)(after.lane_rays - before.lane_rays));
+    atomic_fetch_add(&c->builds, (long long)(after.builds - before.builds));
+    atomic_fetch_add(&c->gathered, (long long)(after.gathered - before.gathered));
 }
 
-lr_status lr_render_region(const lr_renderer *r, int x0, int y0, int x1, int y1, float *rgb,
-                           lr_progress_fn progress, void *user, lr_error *err)
+lr_status lr_render_region_work(const lr_renderer *r, int x0, int y0, int x1, int y1,
+                                float *rgb, lr_progress_fn progress, void *user, lr_work *work,
+                                lr_error *err)
 {
     region_ctx ctx;
     int rc;
+    if (work)
+        memset(work, 0, sizeof *work);
     if (!r || !rgb)
         return fail(err, LR_ERROR_INVALID_ARGUMENT, "%s%s", "NULL renderer or buffer", NULL);
     if (x0 < 0 || y0 < 0 || x0 >= x1 || y0 >= y1 || x1 > r->settings.width ||
@@ -489,8 +503,23 @@ lr_status lr_render_region(const lr_renderer *r, int x0, int y0, int x1, int y1,
     ctx.x0 = x0;
     ctx.y0 = y0;
     ctx.w = x1 - x0;
+    atomic_init(&ctx.pixels, 0);
+    atomic_init(&ctx.rays, 0);
+    atomic_init(&ctx.lane_rays, 0);
+    atomic_init(&ctx.builds, 0);
+    atomic_init(&ctx.gathered, 0);
     rc = rs_render_tiles_cb(x1 - x0, y1 - y0, TILE_SIZE, r->settings.threads, worker_make,
                             worker_free, render_tile, &ctx, progress, user);
+    if (work) {
+        rs_work d = {(double)atomic_load(&ctx.rays), (double)atomic_load(&ctx.lane_rays),
+                     (double)atomic_load(&ctx.builds), (double)atomic_load(&ctx.gathered)};
+        work->pixels = (double)atomic_load(&ctx.pixels);
+        work->rays = d.rays;
+        work->lane_rays = d.lane_rays;
+        work->builds = d.builds;
+        work->gathered = d.gathered;
+        work->cost = rs_work_cost(&d, to_rs_mode(r->settings.mode), work->pixels);
+    }
     if (rc == -2)
         return fail(err, LR_CANCELLED, "%s%s", "the render was cancelled", NULL);
     if (rc != 0)
@@ -499,6 +528,12 @@ lr_status lr_render_region(const lr_renderer *r, int x0, int y0, int x1, int y1,
     if (err)
         memset(err, 0, sizeof *err);
     return LR_OK;
+}
+
+lr_status lr_render_region(const lr_renderer *r, int x0, int y0, int x1, int y1, float *rgb,
+                           lr_progress_fn progress, void *user, lr_error *err)
+{
+    return lr_render_region_work(r, x0, y0, x1, y1, rgb, progress, user, NULL, err);
 }
 
 lr_status lr_render_image(const lr_renderer *r, float *rgb, lr_progress_fn progress, void *user,

@@ -294,6 +294,31 @@ lr_status lr_render_image(const lr_renderer *renderer, float *rgb, lr_progress_f
 lr_status lr_render_region(const lr_renderer *renderer, int x0, int y0, int x1, int y1,
                            float *rgb, lr_progress_fn progress, void *user, lr_error *err);
 
+/* What a render did: counts that depend only on the scene, the options
+ * and the pixels rendered (never on the machine, its load, the threads or
+ * the order), each a whole number, and the price the automatic mode puts
+ * on them.  A measure of cost for benchmarks and for choosing settings. */
+typedef struct lr_work {
+    double pixels;    /* pixels rendered */
+    double rays;      /* rays traced: each a scene intersection and the
+                         shading or lens hit there */
+    double lane_rays; /* the spectral lanes those rays carried, summed */
+    double builds;    /* lens hits' backward builds (one per sub-packet of
+                         equal optics) */
+    double gathered;  /* rays gathered back through lenses (polarized) */
+    double cost;      /* the automatic mode's price of these counts in the
+                         mode rendered: a linear model of them in
+                         instructions of this renderer, fitted to
+                         callgrind's counts by bench/work_cost_fit.sh */
+} lr_work;
+
+/* lr_render_region that also sets *work (when not NULL) to what it did:
+ * the sums over the region's pixels (those rendered, when cancelled).
+ * The same for any number of threads. */
+lr_status lr_render_region_work(const lr_renderer *renderer, int x0, int y0, int x1, int y1,
+                                float *rgb, lr_progress_fn progress, void *user,
+                                lr_work *work, lr_error *err);
+
 #ifdef __cplusplus
 }
 #endif
