@@ -21,7 +21,7 @@
 # predicted / count and the RMS of the relative error of the fit and of the
 # model in the tree, and the fitted function body to paste.  -v also
 # prints each render's line.  Jobs (a scene and a mode each) run JOBS at a
-# time (default 2); about 10 minutes on 2 cores.
+# time (default 2); about 7 minutes of CPU.
 set -eu
 if [ "${1:-}" = --job ]; then
     # one job: --job SCENE W H MODE OUT_PREFIX BIN_DIR

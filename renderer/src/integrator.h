@@ -69,9 +69,17 @@ typedef struct rs_work {
 void rs_worker_work(const rs_worker *w, rs_work *out);
 
 /* The cost of work w done on `pixels` pixels in a mode, in instructions
- * of this renderer: a linear fit of callgrind's counts of 200 renders (10
- * shipped scenes, every mode, 4-64 wavelengths, depth 4 and 16, cut-off
- * 1e-3 and 1e-6, 24 x 18 pixels), 0.55-1.5 times the count, 20 % RMS.
+ * of this renderer: per mode a linear fit (non-negative least squares of
+ * the relative error) of callgrind's counts of the pixels of 560 renders
+ * (14 shipped scenes, every mode, 4-64 wavelengths, depth 4 and 16,
+ * cut-off 1e-3 and 1e-6, 24 x 18 pixels, 12 x 9 for the 3 slowest, one
+ * thread), 0.07-1.55 times the count, 32 % RMS.  What the counters miss
+ * is mostly a scene's own: its intersections' and its lens builds' cost
+ * (the geometric mean of predicted / count is 0.17 on michel_levy's
+ * crystal, 0.49 on machined_parts' CSG, 0.66-1.32 on the others); divided
+ * by that factor, which auto's comparisons of one scene's settings do not
+ * see, 0.40-1.57 times the count, 15 % RMS.  bench/work_cost_fit.sh
+ * reproduces the fit and prints this function's body.
  * Deterministic: it prices what a render will cost on any machine. */
 double rs_work_cost(const rs_work *w, rs_mode mode, double pixels);
 
