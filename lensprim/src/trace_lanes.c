@@ -401,16 +401,14 @@ LP__WIDE static void hit_kernel(lp__lanes *restrict L, const consts *K)
 static size_t between(lp__lanes *restrict L, const consts *K, int absorbs)
 {
     size_t n = L->n_chain, live = 0;
+    /* rim[c] is set on live lanes only */
     for (size_t c = 0; c < n; c++) {
-        if (L->live[c] == 0.0) {
-            L->em[c] = 0.0;
-            continue;
-        }
-        live++;
         double t;
+        if (L->rim[c] == 0.0)
+            continue;
         lp_vec3 p = v3(L->px[c], L->py[c], L->pz[c]);
         lp_vec3 d = v3(L->dx[c], L->dy[c], L->dz[c]);
-        if (L->rim[c] != 0.0 && lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, L->t[c], &t)) {
+        if (lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, L->t[c], &t)) {
             lp_vec3 x = v3_madd(p, d, t);
             L->t[c] = t;
             L->hs[c] = 2.0;
@@ -419,6 +417,13 @@ static size_t between(lp__lanes *restrict L, const consts *K, int absorbs)
             L->hz[c] = x.z;
             L->em[c] = K->ha * t;
         }
+    }
+    for (size_t c = 0; c < n; c++) {
+        if (L->live[c] == 0.0) {
+            L->em[c] = 0.0;
+            continue;
+        }
+        live++;
         L->em[c] = absorbs ? expm1(L->em[c]) : 0.0;
     }
     return live;
