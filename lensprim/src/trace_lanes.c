@@ -56,6 +56,10 @@ struct lp__lanes {
     int max_depth;
     size_t m;                     /* rays in the group */
     size_t n_chain;               /* lanes walking a chain */
+    size_t n_vec;                 /* lanes the vector loops step: n_chain
+                                     rounded up to whole vectors of 4 (the
+                                     rest copies lane 0, not live), so that
+                                     no lane is left to a scalar tail */
     unsigned warnings;            /* of the optics */
     int absorbs;                  /* the glass absorbs */
     unsigned char ray[NL];        /* RAY_* of ray j */
@@ -355,7 +359,7 @@ LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__la
 LP__INLINE void hit_step(lp__lanes *restrict L, const consts *Kp)
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
-    size_t n = L->n_chain;
+    size_t n = L->n_vec;
     for (size_t c = 0; c < n; c++) {
         lp_vec3 p = v3(L->px[c], L->py[c], L->pz[c]);
         lp_vec3 d = v3(L->dx[c], L->dy[c], L->dz[c]);
@@ -426,6 +430,8 @@ static size_t between(lp__lanes *restrict L, const consts *K, int absorbs)
         live++;
         L->em[c] = absorbs ? expm1(L->em[c]) : 0.0;
     }
+    for (size_t c = n; c < L->n_vec; c++)
+        L->em[c] = 0.0;
     return live;
 }
 
@@ -453,7 +459,7 @@ LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law,
                           double (*restrict f)[NL])
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
-    size_t n = L->n_chain;
+    size_t n = L->n_vec;
     for (size_t c = 0; c < n; c++) {
         int was = L->live[c] != 0.0;
         lp_vec3 x = v3(L->hx[c], L->hy[c], L->hz[c]);
@@ -637,6 +643,20 @@ static void pack(lp__lanes *L, const lp__lane_in *in, size_t m)
         n++;
     }
     L->n_chain = n;
+    L->n_vec = (n + 3) & ~(size_t)3;
+    for (size_t c = n; c < L->n_vec; c++) {
+        L->px[c] = L->px[0], L->py[c] = L->py[0], L->pz[c] = L->pz[0];
+        L->dx[c] = L->dx[0], L->dy[c] = L->dy[0], L->dz[c] = L->dz[0];
+        L->ex[c] = L->ex[0], L->ey[c] = L->ey[0], L->ez[c] = L->ez[0];
+        L->fx[c] = L->fy[c] = L->fz[c] = 0.0;
+        L->pw[c] = L->pw[0];
+        L->surf[c] = L->surf[0];
+        L->kphi[c] = 0.0;
+        L->cut[c] = L->cut[0];
+        L->op[c] = L->op[0];
+        L->live[c] = 0.0;
+        L->back[c] = 0.0;
+    }
 }
 
 static void run(lp__lanes *restrict L, const consts *K, const lp_lens *lens,
@@ -669,7 +689,7 @@ void lp__lanes_run(lp__lanes *L, const lp_lens *lens, const lp__optics *o,
     consts K;
     consts_of(&K, lens, o, a);
     L->m = m;
-    L->n_chain = 0;
+    L->n_chain = L->n_vec = 0;
     L->warnings = o->warnings;
     L->absorbs = K.ha < 0.0;
     /* a crystal, or no interface at all: the one-ray code */
