@@ -513,9 +513,13 @@ LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law,
         int cplx = (F.x != 0.0) | (F.y != 0.0) | (F.z != 0.0);
         node_out o;
         fields(L, c, law, K->r0_out, d, E, F, cplx, &o);
-        int odd = (L->live[c] != 0.0) & (L->godd[c] != 0.0);
+        /* Total internal reflection in an unpolarized mode is no odd
+         * node: the one-ray code reflects the real field with R = 1 on
+         * the same axes, as fields does, and sends nothing out. */
+        int tir_here = (law != LP__LAW_POLARIZED) & (L->gtir[c] != 0.0);
+        int odd = (L->live[c] != 0.0) & (L->godd[c] != 0.0) & !tir_here;
         /* a field with an imaginary part leaves by lp__emit_power */
-        f[F_EMIT][c] = cplx ? EMIT_FIELD : EMIT_REAL;
+        f[F_EMIT][c] = tir_here ? EMIT_NONE : (cplx ? EMIT_FIELD : EMIT_REAL);
         f[F_POW][c] = power_of(o.Et, o.Eti);
         f[F_ERX][c] = o.Et.x;
         f[F_ERY][c] = o.Et.y;
@@ -557,8 +561,9 @@ LP__WIDE static void node_kernel(lp__lanes *restrict L, const consts *K, int law
 }
 
 /* The nodes node_step leaves to the one-ray code (odd[c] = 1): total
- * internal reflection, and normal incidence, where the field gives the s
- * axis; by its own node functions, lane by lane. */
+ * internal reflection in polarized mode (complex rs, rp), and normal
+ * incidence, where the field gives the s axis; by its own node
+ * functions, lane by lane. */
 static void odd_step(lp__lanes *restrict L, const lp_lens *lens, const lp__optics *op,
                      lp_mode mode, double (*restrict f)[NL])
 {
