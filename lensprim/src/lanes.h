@@ -236,8 +236,10 @@ typedef struct lp__lane_node {
     lp_vec3 t, r;      /* transmitted and reflected directions */
 } lp__lane_node;
 
-LP__INLINE void lp__lane_node_at(double n1, double n2, double eta, lp_vec3 d, lp_vec3 normal,
-                                 lp__lane_node *g)
+/* lp__lane_node_at but for the last step: g->t and g->r are left to be
+ * normalized (v3_normalize), so that a loop over lanes can do that apart. */
+LP__INLINE void lp__lane_node_raw(double n1, double n2, double eta, lp_vec3 d, lp_vec3 normal,
+                                  lp__lane_node *g)
 {
     double dn = v3_dot(d, normal);
     double adn = fabs(dn);
@@ -254,8 +256,16 @@ LP__INLINE void lp__lane_node_at(double n1, double n2, double eta, lp_vec3 d, lp
     g->is = 1.0 / (g->a + g->b), g->ip = 1.0 / (g->c + g->d);
     g->rs = (g->a - g->b) * g->is;
     g->rp = (g->c - g->d) * g->ip;
-    g->t = v3_normalize(v3_madd(v3_scale(d, eta), g->nn, eta * ci - ct));
-    g->r = v3_normalize(v3_madd(d, g->nn, 2.0 * ci));
+    g->t = v3_madd(v3_scale(d, eta), g->nn, eta * ci - ct);
+    g->r = v3_madd(d, g->nn, 2.0 * ci);
+}
+
+LP__INLINE void lp__lane_node_at(double n1, double n2, double eta, lp_vec3 d, lp_vec3 normal,
+                                 lp__lane_node *g)
+{
+    lp__lane_node_raw(n1, n2, eta, d, normal, g);
+    g->t = v3_normalize(g->t);
+    g->r = v3_normalize(g->r);
 }
 
 /* The law of a node: the mode, and for Schlick's the cosine it takes

@@ -38,3 +38,18 @@ lp_out_ray *lp__result_grow(lp_result *r)
     r->capacity = cap;
     return &r->rays[r->count++];
 }
+
+int lp__result_room(lp_result *r, size_t n)
+{
+    size_t cap = r->capacity ? r->capacity : 16; /* as lp__result_grow */
+    while (cap - r->count < n)
+        cap *= 2;
+    if (cap == r->capacity)
+        return 1;
+    lp_out_ray *p = realloc(r->rays, cap * sizeof *p);
+    if (!p)
+        return 0;
+    r->rays = p;
+    r->capacity = cap;
+    return 1;
+}

@@ -16,4 +16,14 @@ static inline lp_out_ray *lp__result_push(lp_result *r)
     return &r->rays[r->count++];
 }
 
+/* Room for n more rays, so that that many can be appended at
+ * &r->rays[r->count++] without a check; 0 when memory runs out (nothing
+ * changed). */
+int lp__result_room(lp_result *r, size_t n);
+
+static inline int lp__result_reserve(lp_result *r, size_t n)
+{
+    return r->capacity - r->count >= n ? 1 : lp__result_room(r, n);
+}
+
 #endif

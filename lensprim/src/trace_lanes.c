@@ -56,6 +56,10 @@ struct lp__lanes {
     int max_depth;
     size_t m;                     /* rays in the group */
     size_t n_chain;               /* lanes walking a chain */
+    size_t n_vec;                 /* lanes the vector loops step: n_chain
+                                     rounded up to whole vectors of 4 (the
+                                     rest copies lane 0, not live), so that
+                                     no lane is left to a scalar tail */
     unsigned warnings;            /* of the optics */
     int absorbs;                  /* the glass absorbs */
     unsigned char ray[NL];        /* RAY_* of ray j */
@@ -79,6 +83,13 @@ struct lp__lanes {
     /* one step's hit, and the lanes the one-ray code does a part for */
     double t[NL], hs[NL], hx[NL], hy[NL], hz[NL], rim[NL], em[NL], odd[NL], cut_now[NL];
     double odx[NL], ody[NL], odz[NL], oex[NL], oey[NL], oez[NL], ofx[NL], ofy[NL], ofz[NL];
+    /* one node's geometry between the loops of a step (geom) */
+    double gnx[NL], gny[NL], gnz[NL]; /* the cap's outward normal */
+    double gtx[NL], gty[NL], gtz[NL]; /* transmitted direction */
+    double grx[NL], gry[NL], grz[NL]; /* reflected direction */
+    double gsx[NL], gsy[NL], gsz[NL]; /* the s axis */
+    double ga[NL], gb[NL], gis[NL], gip[NL], grs[NL], grp[NL], gci[NL], gct[NL];
+    double gtir[NL], godd[NL];
     double *node;                  /* [depth][NF][NL] for depths 2.. */
 };
 
@@ -129,34 +140,72 @@ static void consts_of(consts *K, const lp_lens *lens, const lp__optics *o, const
 
 /* A node of the field e + i f (lp__lane_node_at, then the field's part of
  * lp__node_setup, lp__node_project, lp__node_transmit_amp and
- * lp__node_reflect_amp) from index n1 into n2, eta = n1/n2.  A field
- * with an imaginary part (after a total internal reflection: only in
- * polarized mode) takes the complex arithmetic of the one-ray code, a
- * real one its real arithmetic.  *odd is set where the one-ray code
- * branches otherwise: total internal reflection, normal incidence. */
+ * lp__node_reflect_amp) from index n1 into n2, eta = n1/n2, in three
+ * passes over the lanes, so that each loop is short and its lanes
+ * overlap (the square roots and divisions of one lane's chain wait on
+ * each other): geom (the geometry and the s axis), units (the directions
+ * normalized), fields (the field on the s and p axes, its amplitudes).
+ * A field with an imaginary part (after a total internal reflection:
+ * only in polarized mode) takes the complex arithmetic of the one-ray
+ * code, a real one its real arithmetic.  godd is set where the one-ray
+ * code branches otherwise: total internal reflection, normal
+ * incidence. */
 typedef struct node_out {
     lp_vec3 t, Et, Eti; /* transmitted direction and field */
     lp_vec3 r, Er, Eri; /* reflected direction and field */
     double flip;        /* 1: a phase jump on reflection */
 } node_out;
 
-LP__INLINE void node(int law, double n1, double n2, double eta, double r0, lp_vec3 d,
-                     lp_vec3 normal, lp_vec3 e, lp_vec3 f, node_out *o, int *odd)
+/* The geometry of lane c's node along d, at the normal gn[c]. */
+LP__INLINE void geom(lp__lanes *restrict L, size_t c, double n1, double n2, double eta, lp_vec3 d)
 {
     lp__lane_node g;
-    lp__lane_node_at(n1, n2, eta, d, normal, &g);
-    /* the s and p axes */
+    lp__lane_node_raw(n1, n2, eta, d, v3(L->gnx[c], L->gny[c], L->gnz[c]), &g);
+    /* the s axis */
     lp_vec3 s = v3_cross(d, g.nn);
     double sl2 = v3_dot(s, s);
-    *odd = g.tir | !(sl2 > 1e-18);
+    int odd = g.tir | !(sl2 > 1e-18);
     s = v3_scale(s, 1.0 / sqrt(sl2));
+    L->gtx[c] = g.t.x, L->gty[c] = g.t.y, L->gtz[c] = g.t.z;
+    L->grx[c] = g.r.x, L->gry[c] = g.r.y, L->grz[c] = g.r.z;
+    L->gsx[c] = s.x, L->gsy[c] = s.y, L->gsz[c] = s.z;
+    L->ga[c] = g.a, L->gb[c] = g.b;
+    L->gis[c] = g.is, L->gip[c] = g.ip;
+    L->grs[c] = g.rs, L->grp[c] = g.rp;
+    L->gci[c] = g.ci, L->gct[c] = g.ct;
+    L->gtir[c] = g.tir ? 1.0 : 0.0;
+    L->godd[c] = odd ? 1.0 : 0.0;
+}
+
+/* The transmitted and reflected directions of lanes 0..n-1, normalized. */
+LP__INLINE void units(lp__lanes *restrict L, size_t n)
+{
+    for (size_t c = 0; c < n; c++) {
+        lp_vec3 t = v3_normalize(v3(L->gtx[c], L->gty[c], L->gtz[c]));
+        lp_vec3 r = v3_normalize(v3(L->grx[c], L->gry[c], L->grz[c]));
+        L->gtx[c] = t.x, L->gty[c] = t.y, L->gtz[c] = t.z;
+        L->grx[c] = r.x, L->gry[c] = r.y, L->grz[c] = r.z;
+    }
+}
+
+/* The outgoing fields of lane c's node for the field e + i f along d
+ * (cplx: f is not 0). */
+LP__INLINE void fields(const lp__lanes *restrict L, size_t c, int law, double r0, lp_vec3 d,
+                       lp_vec3 e, lp_vec3 f, int cplx, node_out *o)
+{
+    lp__lane_node g;
+    g.a = L->ga[c], g.b = L->gb[c];
+    g.is = L->gis[c], g.ip = L->gip[c];
+    g.rs = L->grs[c], g.rp = L->grp[c];
+    g.ci = L->gci[c], g.ct = L->gct[c];
+    g.tir = L->gtir[c] != 0.0;
+    lp_vec3 s = v3(L->gsx[c], L->gsy[c], L->gsz[c]);
     lp_vec3 p = v3_cross(d, s);
     /* the field on them: real parts, and imaginary ones (0 when real) */
-    int cplx = (f.x != 0.0) | (f.y != 0.0) | (f.z != 0.0);
     double es = v3_dot(e, s), ep = v3_dot(e, p);
     double esi = cplx ? v3_dot(f, s) : 0.0, epi = cplx ? v3_dot(f, p) : 0.0;
-    o->t = g.t;
-    o->r = g.r;
+    o->t = v3(L->gtx[c], L->gty[c], L->gtz[c]);
+    o->r = v3(L->grx[c], L->gry[c], L->grz[c]);
     lp_vec3 pt = v3_cross(o->t, s), pr = v3_cross(o->r, s);
     /* the amplitudes on s and p: transmitted (t), reflected (r) */
     double ts_, tp_, tsi, tpi, rs_, rp_, rsi, rpi;
@@ -210,11 +259,14 @@ LP__INLINE double power_real(lp_vec3 e)
     return e.x * e.x + e.y * e.y + e.z * e.z;
 }
 
-/* An outgoing real field (lp__leave, lp__exit_at, lp__field_split) into
- * slot j of the fields f[NF][...] of one node. */
-LP__INLINE void stage(const consts *K, double (*f)[NL], size_t j, lp_vec3 x, lp_vec3 dir,
-                         lp_vec3 e)
+/* An outgoing field from x (lp__leave, lp__exit_at, lp__field_split):
+ * slot j of the fields f[NF][...] of one node holds its local direction
+ * (F_L*) and its field's real part (F_ER*); this adds its world origin,
+ * direction, and field direction. */
+LP__INLINE void stage(const consts *K, double (*f)[NL], size_t j, lp_vec3 x)
 {
+    lp_vec3 dir = v3(f[F_LX][j], f[F_LY][j], f[F_LZ][j]);
+    lp_vec3 e = v3(f[F_ERX][j], f[F_ERY][j], f[F_ERZ][j]);
     lp_vec3 o = lp__lane_world_point(&K->lens, x), dw = lp__lane_world_dir(&K->lens, dir);
     lp_vec3 vp = lp__lane_world_dir(&K->lens, lp__unit_perp(e, dir));
     f[F_OX][j] = o.x;
@@ -226,24 +278,22 @@ LP__INLINE void stage(const consts *K, double (*f)[NL], size_t j, lp_vec3 x, lp_
     f[F_VX][j] = vp.x;
     f[F_VY][j] = vp.y;
     f[F_VZ][j] = vp.z;
-    f[F_POW][j] = power_real(e);
-    f[F_EMIT][j] = EMIT_REAL;
 }
 
 /* ---- the steps ---------------------------------------------------- */
 
 /* Node 1 of every ray taken: the entry hit (lp__lens_hit from outside
- * the lens), the external reflection, the refracted field. */
+ * the lens), the external reflection, the refracted field; in passes
+ * over the rays (see geom). */
 LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__lane_in *in,
                            size_t m, int law)
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
+    double (*restrict f)[NL] = L->r1;
     for (size_t j = 0; j < m; j++) {
         lp_vec3 p = v3(in->px[j], in->py[j], in->pz[j]);
         lp_vec3 d = v3(in->dx[j], in->dy[j], in->dz[j]);
-        lp_vec3 vp = v3(in->vx[j], in->vy[j], in->vz[j]);
-        double I0 = in->intensity[j];
-        int on = lp__lane_on_lens(&K->lens, p), odd;
+        int on = lp__lane_on_lens(&K->lens, p);
         double best;
         lp_vec3 x;
         int rim;
@@ -253,17 +303,41 @@ LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__la
         /* the rim, for the lanes that could meet it: see entry_rim */
         L->rim[j] = rim ? 1.0 : 0.0;
         L->t[j] = best;
-        lp_vec3 n = lp__lane_cap_normal(&K->lens, surf, x);
-        lp_vec3 E = v3_scale(vp, sqrt(I0));
-        node_out o;
-        node(law, K->nm, K->ng, K->eta_in, K->r0_in, d, n, E, v3(0.0, 0.0, 0.0), &o, &odd);
-        stage(K, L->r1, j, x, o.r, o.Er);
-        L->r1[F_KPHI][j] = o.flip;
-        L->r1[F_SURF][j] = surf;
         /* the chain's start, at lane j until the lanes are packed */
         L->px[j] = x.x;
         L->py[j] = x.y;
         L->pz[j] = x.z;
+        L->surf[j] = surf;
+        /* what became of the ray (a start on the lens changes the hit;
+         * odd nodes at the entry are the one-ray code's: below) */
+        double what = cap ? RAY_CHAIN : RAY_MISS;
+        what = on ? RAY_BACK : what;
+        L->hs[j] = L->take[j] != 0.0 ? what : RAY_OFF;
+    }
+    for (size_t j = 0; j < m; j++) {
+        lp_vec3 n = lp__lane_cap_normal(&K->lens, L->surf[j], v3(L->px[j], L->py[j], L->pz[j]));
+        L->gnx[j] = n.x, L->gny[j] = n.y, L->gnz[j] = n.z;
+    }
+    for (size_t j = 0; j < m; j++)
+        geom(L, j, K->nm, K->ng, K->eta_in, v3(in->dx[j], in->dy[j], in->dz[j]));
+    units(L, m);
+    for (size_t j = 0; j < m; j++) {
+        lp_vec3 d = v3(in->dx[j], in->dy[j], in->dz[j]);
+        lp_vec3 vp = v3(in->vx[j], in->vy[j], in->vz[j]);
+        double I0 = in->intensity[j];
+        lp_vec3 E = v3_scale(vp, sqrt(I0));
+        node_out o;
+        fields(L, j, law, K->r0_in, d, E, v3(0.0, 0.0, 0.0), 0, &o);
+        f[F_LX][j] = o.r.x;
+        f[F_LY][j] = o.r.y;
+        f[F_LZ][j] = o.r.z;
+        f[F_ERX][j] = o.Er.x;
+        f[F_ERY][j] = o.Er.y;
+        f[F_ERZ][j] = o.Er.z;
+        f[F_POW][j] = power_real(o.Er);
+        f[F_EMIT][j] = EMIT_REAL;
+        f[F_KPHI][j] = o.flip;
+        f[F_SURF][j] = L->surf[j];
         L->dx[j] = o.t.x;
         L->dy[j] = o.t.y;
         L->dz[j] = o.t.z;
@@ -271,14 +345,12 @@ LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__la
         L->ey[j] = o.Et.y;
         L->ez[j] = o.Et.z;
         L->pw[j] = power_real(o.Et);
-        L->surf[j] = surf;
         L->cut[j] = K->cut_w * I0;
-        /* what became of the ray (a start on the lens changes the hit;
-         * odd nodes at the entry are the one-ray code's) */
-        double what = cap ? (odd ? RAY_BACK : RAY_CHAIN) : RAY_MISS;
-        what = on ? RAY_BACK : what;
-        L->hs[j] = L->take[j] != 0.0 ? what : RAY_OFF;
+        int odd = (L->hs[j] == RAY_CHAIN) & (L->godd[j] != 0.0);
+        L->hs[j] = odd ? RAY_BACK : L->hs[j];
     }
+    for (size_t j = 0; j < m; j++)
+        stage(K, f, j, v3(L->px[j], L->py[j], L->pz[j]));
 }
 
 /* The first half of a step from a node: the weight cut, the next
@@ -287,7 +359,7 @@ LP__INLINE void entry_step(lp__lanes *restrict L, const consts *Kp, const lp__la
 LP__INLINE void hit_step(lp__lanes *restrict L, const consts *Kp)
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
-    size_t n = L->n_chain;
+    size_t n = L->n_vec;
     for (size_t c = 0; c < n; c++) {
         lp_vec3 p = v3(L->px[c], L->py[c], L->pz[c]);
         lp_vec3 d = v3(L->dx[c], L->dy[c], L->dz[c]);
@@ -333,16 +405,14 @@ LP__WIDE static void hit_kernel(lp__lanes *restrict L, const consts *K)
 static size_t between(lp__lanes *restrict L, const consts *K, int absorbs)
 {
     size_t n = L->n_chain, live = 0;
+    /* rim[c] is set on live lanes only */
     for (size_t c = 0; c < n; c++) {
-        if (L->live[c] == 0.0) {
-            L->em[c] = 0.0;
-            continue;
-        }
-        live++;
         double t;
+        if (L->rim[c] == 0.0)
+            continue;
         lp_vec3 p = v3(L->px[c], L->py[c], L->pz[c]);
         lp_vec3 d = v3(L->dx[c], L->dy[c], L->dz[c]);
-        if (L->rim[c] != 0.0 && lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, L->t[c], &t)) {
+        if (lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, L->t[c], &t)) {
             lp_vec3 x = v3_madd(p, d, t);
             L->t[c] = t;
             L->hs[c] = 2.0;
@@ -351,8 +421,17 @@ static size_t between(lp__lanes *restrict L, const consts *K, int absorbs)
             L->hz[c] = x.z;
             L->em[c] = K->ha * t;
         }
+    }
+    for (size_t c = 0; c < n; c++) {
+        if (L->live[c] == 0.0) {
+            L->em[c] = 0.0;
+            continue;
+        }
+        live++;
         L->em[c] = absorbs ? expm1(L->em[c]) : 0.0;
     }
+    for (size_t c = n; c < L->n_vec; c++)
+        L->em[c] = 0.0;
     return live;
 }
 
@@ -373,13 +452,14 @@ static void entry_rim(lp__lanes *restrict L, const consts *K, const lp__lane_in 
 
 /* The second half of a step: the end of the lanes cut, the segment to
  * the hit (absorption, optical path), the rim, the node there: its
- * outgoing ray into f, the reflected field on.  odd[c] = 1 marks the
- * lanes whose node odd_step does instead. */
+ * outgoing ray into f, the reflected field on; in passes over the lanes
+ * (see geom).  odd[c] = 1 marks the lanes whose node odd_step does
+ * instead. */
 LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law,
                           double (*restrict f)[NL])
 {
     const consts Kl = *Kp, *K = &Kl; /* local: the loads are safe to select */
-    size_t n = L->n_chain;
+    size_t n = L->n_vec;
     for (size_t c = 0; c < n; c++) {
         int was = L->live[c] != 0.0;
         lp_vec3 x = v3(L->hx[c], L->hy[c], L->hz[c]);
@@ -399,15 +479,47 @@ LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law,
         f[F_ENDVAL][c] = cut ? L->pw[c] : power_of(E, F);
         int leak = was & (hs < 0.0);
         int live = was & !rim & !leak;
-        lp_vec3 nrm = lp__lane_cap_normal(&K->lens, hs, x);
-        node_out o;
-        int odd;
-        node(law, K->ng, K->nm, K->eta_out, K->r0_out, d, nrm, E, F, &o, &odd);
-        odd = live & odd;
+        f[F_OP][c] = op;
+        f[F_SURF][c] = hs;
+        L->op[c] = op;
+        L->px[c] = x.x;
+        L->py[c] = x.y;
+        L->pz[c] = x.z;
+        /* what the passes below and odd_step start from */
+        L->odx[c] = d.x;
+        L->ody[c] = d.y;
+        L->odz[c] = d.z;
+        L->oex[c] = E.x;
+        L->oey[c] = E.y;
+        L->oez[c] = E.z;
+        L->ofx[c] = F.x;
+        L->ofy[c] = F.y;
+        L->ofz[c] = F.z;
+        L->surf[c] = hs;
+        L->back[c] = L->back[c] + (leak ? 1.0 : 0.0);
+        L->live[c] = live ? 1.0 : 0.0;
+    }
+    for (size_t c = 0; c < n; c++) {
+        lp_vec3 nrm = lp__lane_cap_normal(&K->lens, L->surf[c], v3(L->px[c], L->py[c], L->pz[c]));
+        L->gnx[c] = nrm.x, L->gny[c] = nrm.y, L->gnz[c] = nrm.z;
+    }
+    for (size_t c = 0; c < n; c++)
+        geom(L, c, K->ng, K->nm, K->eta_out, v3(L->odx[c], L->ody[c], L->odz[c]));
+    units(L, n);
+    for (size_t c = 0; c < n; c++) {
+        lp_vec3 d = v3(L->odx[c], L->ody[c], L->odz[c]);
+        lp_vec3 E = v3(L->oex[c], L->oey[c], L->oez[c]);
+        lp_vec3 F = v3(L->ofx[c], L->ofy[c], L->ofz[c]);
         int cplx = (F.x != 0.0) | (F.y != 0.0) | (F.z != 0.0);
-        stage(K, f, c, x, o.t, o.Et);
+        node_out o;
+        fields(L, c, law, K->r0_out, d, E, F, cplx, &o);
+        /* Total internal reflection in an unpolarized mode is no odd
+         * node: the one-ray code reflects the real field with R = 1 on
+         * the same axes, as fields does, and sends nothing out. */
+        int tir_here = (law != LP__LAW_POLARIZED) & (L->gtir[c] != 0.0);
+        int odd = (L->live[c] != 0.0) & (L->godd[c] != 0.0) & !tir_here;
         /* a field with an imaginary part leaves by lp__emit_power */
-        f[F_EMIT][c] = cplx ? EMIT_FIELD : EMIT_REAL;
+        f[F_EMIT][c] = tir_here ? EMIT_NONE : (cplx ? EMIT_FIELD : EMIT_REAL);
         f[F_POW][c] = power_of(o.Et, o.Eti);
         f[F_ERX][c] = o.Et.x;
         f[F_ERY][c] = o.Et.y;
@@ -419,23 +531,7 @@ LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law,
         f[F_LY][c] = o.t.y;
         f[F_LZ][c] = o.t.z;
         f[F_KPHI][c] = L->kphi[c];
-        f[F_OP][c] = op;
-        f[F_SURF][c] = hs;
-        L->op[c] = op;
         L->kphi[c] = L->kphi[c] + (odd ? 0.0 : o.flip);
-        L->px[c] = x.x;
-        L->py[c] = x.y;
-        L->pz[c] = x.z;
-        /* what odd_step starts from */
-        L->odx[c] = d.x;
-        L->ody[c] = d.y;
-        L->odz[c] = d.z;
-        L->oex[c] = E.x;
-        L->oey[c] = E.y;
-        L->oez[c] = E.z;
-        L->ofx[c] = F.x;
-        L->ofy[c] = F.y;
-        L->ofz[c] = F.z;
         /* the reflected field goes on (odd_step's, for an odd lane) */
         L->dx[c] = o.r.x;
         L->dy[c] = o.r.y;
@@ -447,11 +543,10 @@ LP__INLINE void node_step(lp__lanes *restrict L, const consts *Kp, int law,
         L->fy[c] = o.Eri.y;
         L->fz[c] = o.Eri.z;
         L->pw[c] = power_of(o.Er, o.Eri);
-        L->surf[c] = hs;
-        L->back[c] = L->back[c] + (leak ? 1.0 : 0.0);
         L->odd[c] = odd ? 1.0 : 0.0;
-        L->live[c] = live ? 1.0 : 0.0;
     }
+    for (size_t c = 0; c < n; c++)
+        stage(K, f, c, v3(L->px[c], L->py[c], L->pz[c]));
 }
 
 LP__WIDE static void node_kernel(lp__lanes *restrict L, const consts *K, int law,
@@ -466,8 +561,9 @@ LP__WIDE static void node_kernel(lp__lanes *restrict L, const consts *K, int law
 }
 
 /* The nodes node_step leaves to the one-ray code (odd[c] = 1): total
- * internal reflection, and normal incidence, where the field gives the s
- * axis; by its own node functions, lane by lane. */
+ * internal reflection in polarized mode (complex rs, rp), and normal
+ * incidence, where the field gives the s axis; by its own node
+ * functions, lane by lane. */
 static void odd_step(lp__lanes *restrict L, const lp_lens *lens, const lp__optics *op,
                      lp_mode mode, double (*restrict f)[NL])
 {
@@ -552,6 +648,20 @@ static void pack(lp__lanes *L, const lp__lane_in *in, size_t m)
         n++;
     }
     L->n_chain = n;
+    L->n_vec = (n + 3) & ~(size_t)3;
+    for (size_t c = n; c < L->n_vec; c++) {
+        L->px[c] = L->px[0], L->py[c] = L->py[0], L->pz[c] = L->pz[0];
+        L->dx[c] = L->dx[0], L->dy[c] = L->dy[0], L->dz[c] = L->dz[0];
+        L->ex[c] = L->ex[0], L->ey[c] = L->ey[0], L->ez[c] = L->ez[0];
+        L->fx[c] = L->fy[c] = L->fz[c] = 0.0;
+        L->pw[c] = L->pw[0];
+        L->surf[c] = L->surf[0];
+        L->kphi[c] = 0.0;
+        L->cut[c] = L->cut[0];
+        L->op[c] = L->op[0];
+        L->live[c] = 0.0;
+        L->back[c] = 0.0;
+    }
 }
 
 static void run(lp__lanes *restrict L, const consts *K, const lp_lens *lens,
@@ -584,7 +694,7 @@ void lp__lanes_run(lp__lanes *L, const lp_lens *lens, const lp__optics *o,
     consts K;
     consts_of(&K, lens, o, a);
     L->m = m;
-    L->n_chain = 0;
+    L->n_chain = L->n_vec = 0;
     L->warnings = o->warnings;
     L->absorbs = K.ha < 0.0;
     /* a crystal, or no interface at all: the one-ray code */
@@ -611,43 +721,64 @@ int lp__lanes_traced(const lp__lanes *L, size_t j)
     return j < L->m && (L->ray[j] == RAY_MISS || L->ray[j] == RAY_RIM || L->ray[j] == RAY_CHAIN);
 }
 
-/* One outgoing ray of a node (lp__leave): kept (and appended when it
- * carries power) or counted as skipped. */
-LP__INLINE lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
-                       const double (*f)[NL], size_t j, const lp__payload *pl, double phase,
-                       int depth, int kphi, double op, lp_kind kind, int surface, uint64_t path,
-                       lp_error *err)
+/* Field i of the slot a column f (&fields[0][lane]) points at. */
+#define AT(f, i) ((f)[(size_t)(i) * NL])
+
+/* Where lp__lanes_emit appends: the result, its running sum of the power
+ * out (kept here, and written back before any call that reads it), and
+ * whether room for every ray of the chain was made beforehand. */
+typedef struct sink {
+    lp_result *res;
+    double out;
+    int room;
+} sink;
+
+/* One outgoing ray of a node (lp__leave) from the column f: kept (and
+ * appended when it carries power) or counted as skipped.  check: the
+ * flags or the filter may decline it. */
+LP__INLINE lp_status leave(const lp_lens *lens, const lp_trace_args *a, sink *sk,
+                           const double *f, const lp__payload *pl, double phase, int depth,
+                           int kphi, double op, lp_kind kind, int surface, uint64_t path,
+                           int check, lp_error *err)
 {
-    double power = f[F_POW][j];
-    lp_vec3 origin = v3(f[F_OX][j], f[F_OY][j], f[F_OZ][j]);
-    lp_vec3 dir = v3(f[F_DX][j], f[F_DY][j], f[F_DZ][j]);
-    if (a->filter || (kind == LP_KIND_REFLECT && a->flags)) {
+    lp_result *res = sk->res;
+    double power = AT(f, F_POW);
+    lp_vec3 origin = v3(AT(f, F_OX), AT(f, F_OY), AT(f, F_OZ));
+    lp_vec3 dir = v3(AT(f, F_DX), AT(f, F_DY), AT(f, F_DZ));
+    if (check) {
         lp_branch_info info = {depth, kind, surface, origin, dir, power};
-        if (!lp__args_keep(a, &info)) {
+        res->out = sk->out;
+        int keep = lp__args_keep(a, &info);
+        sk->out = res->out;
+        if (!keep) {
             res->skipped += power;
             return LP_OK;
         }
     }
-    if (f[F_EMIT][j] == EMIT_FIELD) {
+    if (AT(f, F_EMIT) == EMIT_FIELD) {
         lp__cvec3 E;
         double *e = (double *)&E;
-        e[0] = f[F_ERX][j], e[1] = f[F_EIX][j];
-        e[2] = f[F_ERY][j], e[3] = f[F_EIY][j];
-        e[4] = f[F_ERZ][j], e[5] = f[F_EIZ][j];
-        lp__exit x = {v3(f[F_LX][j], f[F_LY][j], f[F_LZ][j]), origin, dir};
+        e[0] = AT(f, F_ERX), e[1] = AT(f, F_EIX);
+        e[2] = AT(f, F_ERY), e[3] = AT(f, F_EIY);
+        e[4] = AT(f, F_ERZ), e[5] = AT(f, F_EIZ);
+        lp__exit x = {v3(AT(f, F_LX), AT(f, F_LY), AT(f, F_LZ)), origin, dir};
         lp__payload p = {pl->lambda_nm, kphi, op, pl->phase, pl->ch};
-        return lp__emit_power(lens, res, &E, power, &x, &p, depth, kind, surface, path, err);
+        res->out = sk->out;
+        lp_status st =
+            lp__emit_power(lens, res, &E, power, &x, &p, depth, kind, surface, path, err);
+        sk->out = res->out;
+        return st;
     }
     if (!(power > 0.0))
         return LP_OK;
-    lp_out_ray *o = lp__result_push(res);
+    lp_out_ray *o = sk->room ? &res->rays[res->count++] : lp__result_push(res);
     if (!o)
         return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
     o->ray.origin = origin;
     o->ray.dir = dir;
     o->ray.lambda_nm = pl->lambda_nm;
     o->ray.intensity = power;
-    o->ray.vp = v3(f[F_VX][j], f[F_VY][j], f[F_VZ][j]);
+    o->ray.vp = v3(AT(f, F_VX), AT(f, F_VY), AT(f, F_VZ));
     o->ray.kphi = kphi;
     o->ray.op = op;
     o->ray.phase = phase;
@@ -658,7 +789,55 @@ LP__INLINE lp_status leave(const lp_lens *lens, const lp_trace_args *a, lp_resul
     o->part = 0;
     o->path = path;
     o->waves = 0;
-    res->out += power;
+    sk->out += power;
+    return LP_OK;
+}
+
+/* lp__lanes_emit's work once the ray is known to have entered: its
+ * chain's outgoing rays and sums, with res->out kept in sk.out. */
+LP__INLINE lp_status emit_chain(const lp__lanes *L, size_t j, const lp_lens *lens,
+                            const lp_trace_args *a, const lp__payload *pl, sink *sk,
+                            lp_error *err)
+{
+    lp_result *res = sk->res;
+    lp_status st;
+    size_t c = L->lane[j];
+    int entry = (int)L->entry[c];
+    int check_r = a->filter || a->flags, check_t = a->filter != NULL;
+    double phase = lp__wrap_phase(pl->phase + 0.0);
+    st = leave(lens, a, sk, &L->r1[0][j], pl, phase, 1, pl->kphi + (int)L->r1[F_KPHI][j],
+               pl->op, LP_KIND_REFLECT, entry, 1u, check_r, err);
+    if (st != LP_OK)
+        return st;
+    uint64_t path = 0;
+    int k, staged = L->staged, absorbs = L->absorbs;
+    for (k = 2; k <= staged; k++) {
+        const double *f = L->node + (size_t)k * NF * NL + c;
+        double end = AT(f, F_END);
+        if (end == END_TRUNCATED) {
+            res->truncated += AT(f, F_ENDVAL);
+            break;
+        }
+        if (absorbs)
+            res->absorbed_glass += AT(f, F_ABS);
+        if (end == END_RIM) {
+            res->absorbed_rim += AT(f, F_ENDVAL);
+            break;
+        }
+        if (AT(f, F_EMIT) != EMIT_NONE) {
+            int surface = (int)AT(f, F_SURF);
+            int reflect = surface == entry;
+            st = leave(lens, a, sk, f, pl, phase, k, pl->kphi + (int)AT(f, F_KPHI), AT(f, F_OP),
+                       reflect ? LP_KIND_REFLECT : LP_KIND_TRANSMIT, surface, path,
+                       reflect ? check_r : check_t, err);
+            if (st != LP_OK)
+                return st;
+        }
+        path |= (uint64_t)1 << (k - 1);
+    }
+    if (k > staged)
+        res->truncated += L->final[c]; /* at the depth */
+    res->nodes += (size_t)(k - 1);
     return LP_OK;
 }
 
@@ -666,7 +845,6 @@ lp_status lp__lanes_emit(const lp__lanes *L, size_t j, const lp_lens *lens,
                          const lp_trace_args *a, double intensity, const lp__payload *pl,
                          lp_result *res, lp_error *err)
 {
-    lp_status st;
     if (L->ray[j] == RAY_MISS)
         return LP_OK;
     res->in += intensity;
@@ -675,39 +853,9 @@ lp_status lp__lanes_emit(const lp__lanes *L, size_t j, const lp_lens *lens,
         res->absorbed_rim += intensity;
         return LP_OK;
     }
-    size_t c = L->lane[j];
-    int entry = (int)L->entry[c];
-    double phase = lp__wrap_phase(pl->phase + 0.0);
-    st = leave(lens, a, res, (const double (*)[NL])L->r1, j, pl, phase, 1,
-               pl->kphi + (int)L->r1[F_KPHI][j], pl->op, LP_KIND_REFLECT, entry, 1u, err);
-    if (st != LP_OK)
-        return st;
-    uint64_t path = 0;
-    int k;
-    for (k = 2; k <= L->staged; k++) {
-        const double (*f)[NL] = (const double (*)[NL])(L->node + (size_t)k * NF * NL);
-        if (f[F_END][c] == END_TRUNCATED) {
-            res->truncated += f[F_ENDVAL][c];
-            break;
-        }
-        if (L->absorbs)
-            res->absorbed_glass += f[F_ABS][c];
-        if (f[F_END][c] == END_RIM) {
-            res->absorbed_rim += f[F_ENDVAL][c];
-            break;
-        }
-        if (f[F_EMIT][c] != EMIT_NONE) {
-            int surface = (int)f[F_SURF][c];
-            st = leave(lens, a, res, f, c, pl, phase, k, pl->kphi + (int)f[F_KPHI][c],
-                       f[F_OP][c], surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
-                       surface, path, err);
-            if (st != LP_OK)
-                return st;
-        }
-        path |= (uint64_t)1 << (k - 1);
-    }
-    if (k > L->staged)
-        res->truncated += L->final[c]; /* at the depth */
-    res->nodes += (size_t)(k - 1);
-    return LP_OK;
+    /* at most two rays a node (the parts of an elliptical field) */
+    sink sk = {res, res->out, lp__result_reserve(res, 2 * (size_t)L->staged)};
+    lp_status st = emit_chain(L, j, lens, a, pl, &sk, err);
+    res->out = sk.out;
+    return st;
 }
