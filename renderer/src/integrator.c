@@ -146,6 +146,7 @@ typedef struct frame {
     int *sub_at, *sub_lane, *sub_pos;
     double *sub_lambda;
     unsigned char *sub_ok;
+    int *sub_of, *slot; /* rs_packet_split's scratch (slot: all -1) */
     int n_sub, sub_next;
     query_memo qm;
     bundle child;
@@ -445,6 +446,8 @@ static void frame_free(frame *fr)
     free(fr->sub_pos);
     free(fr->sub_lambda);
     free(fr->sub_ok);
+    free(fr->sub_of);
+    free(fr->slot);
     free(fr->child.r);
     free(fr->child.lane);
     free(fr->child.I);
@@ -516,9 +519,14 @@ static frame *get_frame(rs_worker *w, int f)
         fr->sub_pos = calloc(n, sizeof *fr->sub_pos);
         fr->sub_lambda = calloc(n, sizeof *fr->sub_lambda);
         fr->sub_ok = calloc(n, 1);
+        fr->sub_of = calloc(n, sizeof *fr->sub_of);
+        fr->slot = malloc(n * sizeof *fr->slot);
+        if (fr->slot)
+            for (size_t k = 0; k < n; k++)
+                fr->slot[k] = -1;
         if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach || !fr->bad ||
             !fr->cb || !fr->hs || !fr->light_v || !fr->light_got || !fr->bws || !fr->sub_at ||
-            !fr->sub_lane || !fr->sub_pos || !fr->sub_lambda || !fr->sub_ok ||
+            !fr->sub_lane || !fr->sub_pos || !fr->sub_lambda || !fr->sub_ok || !fr->sub_of || !fr->slot ||
             lp_backward_create(&fr->bws[0], NULL) != LP_OK) {
             frame_free(fr);
             return NULL;
@@ -1068,7 +1076,7 @@ static int lens_args(const rs_integrator *it, int level, double weight, lp_trace
 }
 
 /* A lens hit of the packet lane[0..n) at lens `object` along (o, d): its
- * sub-packets (lanes of equal optics there, rs_packet_next, in the
+ * sub-packets (lanes of equal optics there, rs_packet_split, in the
  * frame's sub_ arrays) and their backward builds, made at once -- at a
  * dispersive lens, one lp_backward_build_many for the sub-packets'
  * wavelengths, each build exactly lp_backward_build's.  lens_next then
@@ -1076,21 +1084,18 @@ static int lens_args(const rs_integrator *it, int level, double weight, lp_trace
 static int lens_builds(const rs_integrator *it, frame *fr, const rs_object *ob, int object,
                        const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a)
 {
-    int m, ns = 0, at = 0;
-    memset(fr->done, 0, (size_t)n);
-    while ((m = rs_packet_next(it->classes, object, lane, n, fr->done, fr->sub_pos + at)) > 0) {
-        if (ns == fr->n_bws) {
-            if (lp_backward_create(&fr->bws[ns], NULL) != LP_OK)
+    int ns = rs_packet_split(it->classes, object, lane, n, fr->sub_at, fr->sub_pos, fr->sub_of,
+                             fr->slot);
+    for (int s = 0; s < ns; s++) {
+        if (s == fr->n_bws) {
+            if (lp_backward_create(&fr->bws[s], NULL) != LP_OK)
                 return -1;
             fr->n_bws++;
         }
-        fr->sub_at[ns] = at;
-        for (int k = 0; k < m; k++)
-            fr->sub_lane[at + k] = lane[fr->sub_pos[at + k]];
-        fr->sub_lambda[ns++] = it->lanes[fr->sub_lane[at]].lambda;
-        at += m;
+        for (int k = fr->sub_at[s]; k < fr->sub_at[s + 1]; k++)
+            fr->sub_lane[k] = lane[fr->sub_pos[k]];
+        fr->sub_lambda[s] = it->lanes[fr->sub_lane[fr->sub_at[s]]].lambda;
     }
-    fr->sub_at[ns] = at;
     fr->n_sub = ns;
     fr->sub_next = 0;
     int all = ns > 1 && lp_backward_build_many(fr->bws, (size_t)ns, ob->lens, o, d,
@@ -1135,26 +1140,41 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     trace_scalar_hit(w, lane, n, o, d, found ? &h : NULL, level, weight, f, out);
 }
 
-/* Where query q of a lens hit's sub-packet meets the scene (NULL:
- * nowhere).  The reflection off the outside (depth 1) does not depend on
- * the wavelength: its hit is kept for the next sub-packet of the same lens
- * hit (a dispersive lens splits every lane off), which meets the scene
- * at the same point when its ray is the same. */
-static const rs_hit *query_hit(const rs_scene *sc, frame *fr, const lp_query *q)
+/* Where query j of a lens hit's sub-packet meets the scene (NULL:
+ * nowhere).  The lens hit was object `object` (a lens of the scene's own
+ * list, or a CSG's member: -1): where the build certifies that the query
+ * ray cannot meet its lens again (lp_backward_query_leaves), the lens is
+ * left out of the test, which finds the same hit.  The reflection off the
+ * outside (depth 1) does not depend on the wavelength: its hit is kept for
+ * the next sub-packet of the same lens hit (a dispersive lens splits every
+ * lane off), which meets the scene at the same point when its ray is the
+ * same. */
+static const rs_hit *query_hit(const rs_scene *sc, frame *fr, const lp_query *q, size_t j,
+                               int object)
 {
     query_memo *m = &fr->qm;
+    q += j;
     if (q->depth != 1) {
-        int found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h_other);
+        int skip = object >= 0 && lp_backward_query_leaves(fr->bw, j) ? object : -1;
+        int found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, skip, &m->h_other);
         return found ? &m->h_other : NULL;
     }
     if (!m->valid || memcmp(&m->origin, &q->origin, sizeof m->origin) != 0 ||
         memcmp(&m->dir, &q->dir, sizeof m->dir) != 0) {
+        int skip = object >= 0 && lp_backward_query_leaves(fr->bw, j) ? object : -1;
         m->origin = q->origin;
         m->dir = q->dir;
-        m->found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h);
+        m->found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, skip, &m->h);
         m->valid = 1;
     }
     return m->found ? &m->h : NULL;
+}
+
+/* The object index of a lens hit h for query_hit: h.object when the lens
+ * is that object itself, -1 when it is a member of it (a CSG). */
+static int lens_object(const rs_scene *sc, const rs_hit *h)
+{
+    return &sc->objects[h->object] == h->surface ? h->object : -1;
 }
 
 /* trace_scalar once the ray's hit is known (NULL: it meets nothing). */
@@ -1191,7 +1211,8 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
             for (int k = 0; k < m; k++)
                 fr->acc[k] = 0.0;
             for (size_t j = 0; j < nq; j++) {
-                trace_scalar_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
+                trace_scalar_hit(w, fr->lane, m, q[j].origin, q[j].dir,
+                                 query_hit(sc, fr, q, j, lens_object(sc, &h)),
                                  level + q[j].depth, weight * q[j].weight, f + 1, fr->val);
                 for (int k = 0; k < m; k++)
                     fr->acc[k] += q[j].weight * fr->val[k];
@@ -1674,7 +1695,8 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
             w->work.builds += 1.0;
             for (size_t j = 0; j < nq; j++) {
                 bundle_clear(&fr->child);
-                trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
+                trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir,
+                              query_hit(sc, fr, q, j, lens_object(sc, &h)),
                               level + q[j].depth, weight * q[j].bound, f + 1, &fr->child);
                 if (fr->child.n == 0)
                     continue;
