@@ -101,6 +101,8 @@ int lp_backward_query_leaves(const lp_backward *bw, size_t q)
 {
     if (!bw || lp__xback_active(bw->xb) || q >= bw->n_queries)
         return 0;
+    if (bw->leaves[q] >= 0)
+        return bw->leaves[q];
     return leaves_lens(bw->lens, bw->query[q].origin, bw->query[q].dir);
 }
 
@@ -191,12 +193,13 @@ void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surfac
 {
     lp__backward_add_query_at(bw, depth, kind, surface, dir,
                               lp__to_world_point(bw->lens, bw->node[depth].p),
-                              lp__to_world_dir(bw->lens, dir), path, op, bound, weight);
+                              lp__to_world_dir(bw->lens, dir), path, op, bound, weight, -1);
 }
 
 void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
                                lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
-                               uint64_t path, double op, double bound, double weight)
+                               uint64_t path, double op, double bound, double weight,
+                               int leaves)
 {
     lp_query *q = &bw->query[bw->n_queries];
     lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
@@ -214,6 +217,7 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
     q->weight = weight;
     q->waves = 0;
     bw->query_dir[bw->n_queries] = dir;
+    bw->leaves[bw->n_queries] = (signed char)leaves;
     bw->n_queries++;
 }
 
