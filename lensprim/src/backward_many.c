@@ -347,13 +347,14 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         uint64_t path = 0;
         for (int j = 1; j <= b->n_nodes; j++) {
             if (cand[k][j]) {
-                lp_query q = b->query[j - 1];
-                lp_vec3 dir = b->query_dir[j - 1];
-                int leaves = b->leaves[j - 1];
+                /* the candidate's slot: the query made from it goes to
+                 * this slot or an earlier one, after the arguments are read */
+                const lp_query *q = &b->query[j - 1];
                 int surface = b->node[j].surface;
                 lp_kind kind = j == 1 || surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
-                lp__backward_add_query_at(b, j, kind, surface, dir, q.origin, q.dir,
-                                          j == 1 ? 1u : path, q.op, q.bound, q.weight, leaves);
+                lp__backward_add_query_at(b, j, kind, surface, b->query_dir[j - 1], q->origin,
+                                          q->dir, j == 1 ? 1u : path, q->op, q->bound,
+                                          q->weight, b->leaves[j - 1]);
             }
             if (j > 1)
                 path |= (uint64_t)1 << (j - 1);

@@ -202,10 +202,14 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
                                int leaves)
 {
     lp_query *q = &bw->query[bw->n_queries];
-    lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
 
-    if (bound < bw->args.min_weight || !lp__args_keep(&bw->args, &info))
+    if (bound < bw->args.min_weight)
         return;
+    if (bw->args.flags != 0 || bw->args.filter) { /* else lp__args_keep keeps it */
+        lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
+        if (!lp__args_keep(&bw->args, &info))
+            return;
+    }
     q->origin = world_origin;
     q->dir = world_dir;
     q->depth = depth;

@@ -692,19 +692,23 @@ static int make_lane_tables(rs_integrator *it)
     return 0;
 }
 
-/* Colour c for use `kind` (see colour_entry) in lanes lane[0..n), at
- * [lane] of the array returned (the other lanes' values may be stale):
- * band_reflectance for the pigment and mirror colours, band_emission for
- * the others.  Valid until the next look-up of this kind. */
-static const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane, int n)
+/* lane_colour's entry of colour c (in the table of each use): the hash
+ * of its bits picks it. */
+static size_t colour_slot(const rs_worker *w, rs_color c)
 {
-    const rs_integrator *it = w->it;
     uint64_t u[3], h;
     memcpy(&u[0], &c.r, sizeof u[0]);
     memcpy(&u[1], &c.g, sizeof u[1]);
     memcpy(&u[2], &c.b, sizeof u[2]);
     h = (u[0] * 0x9E3779B97F4A7C15u) ^ (u[1] * 0xC2B2AE3D27D4EB4Fu) ^ (u[2] * 0x165667B19E3779F9u);
-    size_t e = (size_t)(h >> 58) & (w->cc_n - 1);
+    return (size_t)(h >> 58) & (w->cc_n - 1);
+}
+
+/* lane_colour where entry e does not yet hold c in every lane. */
+static const double *lane_colour_fill(rs_worker *w, int kind, size_t e, rs_color c,
+                                      const int *lane, int n)
+{
+    const rs_integrator *it = w->it;
     colour_entry *ce = &w->cc[kind][e];
     size_t at = ((size_t)kind * w->cc_n + e) * (size_t)it->n_lanes;
     double *v = w->cc_val + at;
@@ -731,16 +735,36 @@ static const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *
     return v;
 }
 
+/* Colour c for use `kind` (see colour_entry) in lanes lane[0..n), at
+ * [lane] of the array returned (the other lanes' values may be stale):
+ * band_reflectance for the pigment and mirror colours, band_emission for
+ * the others.  Valid until the next look-up of this kind.  Inline, the
+ * look-up of a colour held in every lane already (the usual case). */
+static inline const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane,
+                                        int n)
+{
+    size_t e = colour_slot(w, c);
+    const colour_entry *ce = &w->cc[kind][e];
+    if (ce->gen != 0 && ce->n_valid == w->it->n_lanes && memcmp(&ce->c, &c, sizeof c) == 0)
+        return w->cc_val + ((size_t)kind * w->cc_n + e) * (size_t)w->it->n_lanes;
+    return lane_colour_fill(w, kind, e, c, lane, n);
+}
+
 /* The parity (0 or 1) of floor(v + 1e-10) for any v: below 2^62 the
- * integer's own low bit (two's complement: -3 is odd too); beyond, where
- * a cast to long long would overflow, fmod, exact at every magnitude (a
- * double beyond 2^53 is an integer); not finite: 0. */
+ * integer's own low bit (two's complement: -3 is odd too), the floor
+ * taken as the cast's truncation, one less where that lies above (exact:
+ * the truncation of a double is a double); beyond, where a cast to long
+ * long would overflow, fmod, exact at every magnitude (a double beyond
+ * 2^53 is an integer); not finite: 0. */
 static int floor_parity(double v)
 {
-    double f = floor(v + 1e-10);
-    if (fabs(f) < 0x1p62)
-        return (int)((long long)f & 1);
-    double r = fmod(f, 2.0);
+    double x = v + 1e-10;
+    if (fabs(x) < 0x1p62) {
+        long long i = (long long)x;
+        i -= (double)i > x;
+        return (int)(i & 1);
+    }
+    double r = fmod(floor(x), 2.0);
     return r != 0.0 && r == r; /* -1 or 1: odd; NaN: 0 */
 }
 
@@ -841,12 +865,17 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
         blocked = rs_bvh_any(sc->bvh, x, d, sg.eps, dist, shadow_meets, &sg);
     } else {
         rs_slab_ray r;
-        int boxes = sc->bvh && rs_bvh_object_count(sc->bvh) == sc->n_objects;
-        if (boxes)
-            rs_slab_ray_init(&r, x, d);
-        for (size_t i = 0; i < sc->n_objects && !blocked; i++)
-            if (!boxes || rs_bvh_may_meet(sc->bvh, (int)i, &r, sg.eps, dist))
-                blocked = shadow_meets(&sg, (int)i);
+        int boxes = sc->bvh && rs_bvh_object_count(sc->bvh) == sc->n_objects, ready = 0;
+        for (size_t i = 0; i < sc->n_objects && !blocked; i++) {
+            if (boxes && rs_bvh_culls(sc->bvh, (int)i)) { /* the ray for boxes, once needed */
+                if (!ready)
+                    rs_slab_ray_init(&r, x, d);
+                ready = 1;
+                if (!rs_bvh_may_meet(sc->bvh, (int)i, &r, sg.eps, dist))
+                    continue;
+            }
+            blocked = shadow_meets(&sg, (int)i);
+        }
     }
     if (blocked)
         return 0.0;
