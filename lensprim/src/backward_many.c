@@ -13,7 +13,9 @@
  * one-ray code's, lane by lane.  Each step writes its nodes straight into
  * the lanes' lp_backward; the queries are made at the end, wavelength by
  * wavelength in depth order (lp__backward_add_query_at: the flags and the
- * filter are called in the order of lp_backward_build). */
+ * filter are called in the order of lp_backward_build).  Each query's
+ * certificate that its ray leaves the lens (lp_backward_query_leaves) is
+ * made in the lanes too, with the one-ray code's arithmetic. */
 #include <math.h>
 #include <string.h>
 
