@@ -598,6 +598,13 @@ LP_API const lp_query *lp_backward_queries(const lp_backward *bw);
  * crystal, the smallest depth at which a branch of its tree did. */
 LP_API int lp_backward_rim_depth(const lp_backward *bw);
 
+/* (Revision 2) 1 when query q's ray certainly does not meet bw's lens
+ * again: lp_lens_intersect(lens, query.origin, query.dir, 0, t_max) gives
+ * no hit, whatever t_max, so a renderer may leave the lens out of the
+ * query ray's scene test.  0 when that is not certain, and for a crystal
+ * lens or a query that does not exist. */
+LP_API int lp_backward_query_leaves(const lp_backward *bw, size_t q);
+
 /* Phase 2, gather.  bundle[0..n) are linearly polarized rays arriving
  * back along query q (their origin and dir are ignored: they travel along
  * -query.dir).  Each is carried through the path's nodes in the direction

@@ -36,6 +36,9 @@ struct lp_backward {
     size_t n_queries;
     lp_query query[LP_MAX_DEPTH];
     lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
+    /* per query: 1 its ray leaves the lens for sure, 0 not for sure, -1
+     * not known yet (lp_backward_query_leaves works it out) */
+    signed char leaves[LP_MAX_DEPTH];
     lp__exit exit;                   /* where gathered light leaves */
     int rim_depth;
     unsigned warnings;
@@ -55,10 +58,12 @@ void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surfac
                             uint64_t path, double op, double bound, double weight);
 
 /* The same with the query's world origin (of bw->node[depth].p) and world
- * direction (of dir) given. */
+ * direction (of dir) given, and whether its ray leaves the lens (as
+ * bw->leaves). */
 void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
                                lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
-                               uint64_t path, double op, double bound, double weight);
+                               uint64_t path, double op, double bound, double weight,
+                               int leaves);
 
 /* Once a build of bw is done: in the polarized mode, whose light comes
  * only by gathering, set up the ways of every gather of its queries

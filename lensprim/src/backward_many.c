@@ -13,7 +13,9 @@
  * one-ray code's, lane by lane.  Each step writes its nodes straight into
  * the lanes' lp_backward; the queries are made at the end, wavelength by
  * wavelength in depth order (lp__backward_add_query_at: the flags and the
- * filter are called in the order of lp_backward_build). */
+ * filter are called in the order of lp_backward_build).  Each query's
+ * certificate that its ray leaves the lens (lp_backward_query_leaves) is
+ * made in the lanes too, with the one-ray code's arithmetic. */
 #include <math.h>
 #include <string.h>
 
@@ -41,6 +43,7 @@ typedef struct wl_lanes {
     double qx[NW], qy[NW], qz[NW], qb[NW], qw[NW], tir[NW];
     /* the query in the world: its origin (the node) and direction */
     double wox[NW], woy[NW], woz[NW], wdx[NW], wdy[NW], wdz[NW];
+    double lv[NW]; /* whether the query leaves the lens (leaves_step) */
 } wl_lanes;
 
 /* The bound and weight factors of a node (trace_backward.c's node_bound
@@ -165,6 +168,41 @@ LP__INLINE void node_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *K
     }
 }
 
+/* Whether each lane's query ray (world origin wo, direction wd) leaves
+ * the lens for sure: trace_backward.c's leaves_lens, the one-ray code's
+ * arithmetic (lp_lens_intersect's normalization and local ray,
+ * lp__lens_surface_at, the caps from the surface found) in lanes: 1 it
+ * leaves, 0 not for sure (from no cap, or a cap hit), -1 where only the
+ * rim's own test can tell (leaves_lens decides when asked). */
+LP__INLINE void leaves_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp)
+{
+    const lp__lane_lens K = *Kp;
+    double t_other = lp__max(0.0, K.eps), tol = K.tol;
+    for (size_t k = 0; k < n; k++) {
+        lp_vec3 d = v3_normalize(v3(W->wdx[k], W->wdy[k], W->wdz[k]));
+        lp_vec3 o = v3_sub(v3(W->wox[k], W->woy[k], W->woz[k]), K.pos);
+        lp_vec3 p = v3(v3_dot(o, K.u), v3_dot(o, K.v), v3_dot(o, K.w));
+        lp_vec3 dl = v3(v3_dot(d, K.u), v3_dot(d, K.v), v3_dot(d, K.w));
+        /* lp__lens_surface_at: the front cap, else the back one */
+        double r2 = p.x * p.x + p.y * p.y;
+        double z0 = p.z - K.z0[0], z1 = p.z - K.z0[1];
+        double f0 = K.c[0] * (r2 + z0 * z0) - 2.0 * z0;
+        double f1 = K.c[1] * (r2 + z1 * z1) - 2.0 * z1;
+        int on0 = (fabs(f0) <= 2.0 * tol) & (r2 <= K.hh[0] + tol) & (K.c[0] * z0 <= 1.0);
+        int on1 = !on0 & (fabs(f1) <= 2.0 * tol) & (r2 <= K.hh[1] + tol) & (K.c[1] * z1 <= 1.0);
+        double ts, to;
+        int hself = lp__lane_cap_self(on1 ? K.c[1] : K.c[0], on1 ? K.z0[1] : K.z0[0],
+                                      on1 ? K.hh[1] : K.hh[0], p, dl, 0.0, &ts);
+        int hother = lp__lane_cap_far(on1 ? K.c[0] : K.c[1], on1 ? K.z0[0] : K.z0[1],
+                                      on1 ? K.hh[0] : K.hh[1], p, dl, t_other, &to);
+        int below = (dl.z <= 0.0) & (p.z < K.r.z_a - K.slack);
+        int above = (dl.z >= 0.0) & (p.z > K.r.z_b + K.slack);
+        int clear = (on0 | on1) & !hself & !hother;
+        int sure = (K.has_rim == 0.0) | below | above;
+        W->lv[k] = clear ? (sure ? 1.0 : -1.0) : 0.0;
+    }
+}
+
 /* The vector loops, each in one copy per mode and vector width. */
 LP__WIDE static void entry_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K,
                                   lp_mode mode, lp_vec3 d, lp_vec3 hn)
@@ -180,6 +218,11 @@ LP__WIDE static void hit_kernel(wl_lanes *restrict W, size_t n, const lp__lane_l
                                 double min_weight)
 {
     hit_step(W, n, K, min_weight);
+}
+
+LP__WIDE static void leaves_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K)
+{
+    leaves_step(W, n, K);
 }
 
 LP__WIDE static void node_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K,
@@ -205,6 +248,7 @@ static void keep_candidate(lp_backward *bw, int depth, const wl_lanes *W, size_t
     q->op = W->op[k];
     q->bound = W->qb[k];
     q->weight = W->qw[k];
+    bw->leaves[depth - 1] = (signed char)W->lv[k];
 }
 
 /* Wavelengths k0 .. k0+n of a cap hit h of the view ray (local
@@ -233,6 +277,9 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
     entry_kernel(&W, n, K, mode, d, h->n);
     lp__exit exit = lp__exit_at(lens, h->p, v3_neg(d));
     lp_vec3 wo1 = lp__to_world_point(lens, h->p);
+    for (size_t k = 0; k < n; k++)
+        W.wox[k] = wo1.x, W.woy[k] = wo1.y, W.woz[k] = wo1.z;
+    leaves_kernel(&W, n, K);
     for (size_t k = 0; k < n; k++) {
         lp_backward *b = bw[k];
         b->exit = exit;
@@ -266,6 +313,7 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         if (live == 0)
             break;
         node_kernel(&W, n, K, mode);
+        leaves_kernel(&W, n, K);
         for (size_t k = 0; k < n; k++) {
             if (W.live[k] == 0.0)
                 continue;
@@ -301,12 +349,14 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         uint64_t path = 0;
         for (int j = 1; j <= b->n_nodes; j++) {
             if (cand[k][j]) {
-                lp_query q = b->query[j - 1];
-                lp_vec3 dir = b->query_dir[j - 1];
+                /* the candidate's slot: the query made from it goes to
+                 * this slot or an earlier one, after the arguments are read */
+                const lp_query *q = &b->query[j - 1];
                 int surface = b->node[j].surface;
                 lp_kind kind = j == 1 || surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
-                lp__backward_add_query_at(b, j, kind, surface, dir, q.origin, q.dir,
-                                          j == 1 ? 1u : path, q.op, q.bound, q.weight);
+                lp__backward_add_query_at(b, j, kind, surface, b->query_dir[j - 1], q->origin,
+                                          q->dir, j == 1 ? 1u : path, q->op, q->bound,
+                                          q->weight, b->leaves[j - 1]);
             }
             if (j > 1)
                 path |= (uint64_t)1 << (j - 1);

@@ -20,6 +20,7 @@
 #include <stdlib.h>
 
 #include "backward.h"
+#include "cap.h"
 #include "error.h"
 #include "interface.h"
 
@@ -60,6 +61,49 @@ int lp_backward_rim_depth(const lp_backward *bw)
     if (bw && lp__xback_active(bw->xb))
         return lp__xback_rim_depth(bw->xb);
     return bw ? bw->rim_depth : 0;
+}
+
+/* Whether lp_lens_intersect(lens, origin, dir, 0, t_max) certainly
+ * returns 0 for every t_max.  Where that call would not look at the
+ * caps (a ray not finite, of no direction, or away from the lens's
+ * bounding sphere) it returns 0 anyway, so any answer is right there; else
+ * this is the same arithmetic as that call with t_max = INFINITY (lens.c:
+ * the local ray, the surface it leaves, each cap; its steps in the same
+ * order, so every number is the same), but that the rim's test is
+ * skipped where no root can pass its z range (a ray from below it going
+ * down, or from above it going up: p.z + s d.z with s > 0 stays on p's
+ * side of it).  With no hit at t_max = INFINITY there is none below any
+ * t_max: every test only narrows.  0 where not certain (a ray from no
+ * cap). */
+static int leaves_lens(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir)
+{
+    lp_vec3 d = v3_normalize(dir);
+    lp_vec3 p = lp__to_local_point(lens, origin), dl = lp__to_local_dir(lens, d);
+    int from = lp__lens_surface_at(lens, p);
+    if (from != LP_SURFACE_FRONT && from != LP_SURFACE_BACK)
+        return 0;
+    double t, t_other = lp__max(0.0, lens->eps);
+    for (int s = LP_SURFACE_FRONT; s <= LP_SURFACE_BACK; s++) {
+        int self = s == from;
+        if (lp__cap_intersect(&lens->cap[s], p, dl, self, self ? 0.0 : t_other, INFINITY, &t))
+            return 0;
+    }
+    const lp__rim *rim = &lens->rim;
+    if (!rim->present)
+        return 1;
+    double slack = 1e-12 * (rim->z_b - rim->z_a + rim->rho_a + rim->rho_b); /* rim.c's */
+    if ((dl.z <= 0.0 && p.z < rim->z_a - slack) || (dl.z >= 0.0 && p.z > rim->z_b + slack))
+        return 1;
+    return !lp__rim_intersect(rim, p, dl, t_other, INFINITY, &t);
+}
+
+int lp_backward_query_leaves(const lp_backward *bw, size_t q)
+{
+    if (!bw || lp__xback_active(bw->xb) || q >= bw->n_queries)
+        return 0;
+    if (bw->leaves[q] >= 0)
+        return bw->leaves[q];
+    return leaves_lens(bw->lens, bw->query[q].origin, bw->query[q].dir);
 }
 
 /* Power factors of a node for the bound (max over s/p) and the
@@ -149,18 +193,23 @@ void lp__backward_add_query(lp_backward *bw, int depth, lp_kind kind, int surfac
 {
     lp__backward_add_query_at(bw, depth, kind, surface, dir,
                               lp__to_world_point(bw->lens, bw->node[depth].p),
-                              lp__to_world_dir(bw->lens, dir), path, op, bound, weight);
+                              lp__to_world_dir(bw->lens, dir), path, op, bound, weight, -1);
 }
 
 void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int surface,
                                lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
-                               uint64_t path, double op, double bound, double weight)
+                               uint64_t path, double op, double bound, double weight,
+                               int leaves)
 {
     lp_query *q = &bw->query[bw->n_queries];
-    lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
 
-    if (bound < bw->args.min_weight || !lp__args_keep(&bw->args, &info))
+    if (bound < bw->args.min_weight)
         return;
+    if (bw->args.flags != 0 || bw->args.filter) { /* else lp__args_keep keeps it */
+        lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
+        if (!lp__args_keep(&bw->args, &info))
+            return;
+    }
     q->origin = world_origin;
     q->dir = world_dir;
     q->depth = depth;
@@ -172,6 +221,7 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
     q->weight = weight;
     q->waves = 0;
     bw->query_dir[bw->n_queries] = dir;
+    bw->leaves[bw->n_queries] = (signed char)leaves;
     bw->n_queries++;
 }
 

@@ -318,9 +318,14 @@ static int slab_hit(const slab_ray *r, const bvh_node *nd, double t0, double t1)
     return slab_box(r, nd->lo, nd->hi, t0, t1);
 }
 
+int rs_bvh_culls(const rs_bvh *b, int i)
+{
+    return b && i >= 0 && (size_t)i < b->n_objects && b->cull[i];
+}
+
 int rs_bvh_may_meet(const rs_bvh *b, int i, const slab_ray *r, double t_min, double t_max)
 {
-    if (!b || i < 0 || (size_t)i >= b->n_objects || !b->cull[i])
+    if (!rs_bvh_culls(b, i))
         return 1;
     return slab_box(r, b->box[i], b->box[i] + 3, t_min, t_max);
 }

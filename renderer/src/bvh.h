@@ -69,6 +69,10 @@ void rs_slab_ray_init(rs_slab_ray *r, lp_vec3 origin, lp_vec3 dir);
 int rs_bvh_may_meet(const rs_bvh *bvh, int object, const rs_slab_ray *r, double t_min,
                     double t_max);
 
+/* Whether rs_bvh_may_meet tests object i's box (else it is 1 without
+ * reading its ray): a loop may prepare the ray only once one needs it. */
+int rs_bvh_culls(const rs_bvh *bvh, int object);
+
 /* Number of tree nodes, of unbounded objects (for tests and benchmarks),
  * and of the scene's objects when it was built. */
 size_t rs_bvh_node_count(const rs_bvh *bvh);

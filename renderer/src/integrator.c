@@ -146,6 +146,7 @@ typedef struct frame {
     int *sub_at, *sub_lane, *sub_pos;
     double *sub_lambda;
     unsigned char *sub_ok;
+    int *sub_of, *slot; /* rs_packet_split's scratch (slot: all -1) */
     int n_sub, sub_next;
     query_memo qm;
     bundle child;
@@ -445,6 +446,8 @@ static void frame_free(frame *fr)
     free(fr->sub_pos);
     free(fr->sub_lambda);
     free(fr->sub_ok);
+    free(fr->sub_of);
+    free(fr->slot);
     free(fr->child.r);
     free(fr->child.lane);
     free(fr->child.I);
@@ -516,9 +519,14 @@ static frame *get_frame(rs_worker *w, int f)
         fr->sub_pos = calloc(n, sizeof *fr->sub_pos);
         fr->sub_lambda = calloc(n, sizeof *fr->sub_lambda);
         fr->sub_ok = calloc(n, 1);
+        fr->sub_of = calloc(n, sizeof *fr->sub_of);
+        fr->slot = malloc(n * sizeof *fr->slot);
+        if (fr->slot)
+            for (size_t k = 0; k < n; k++)
+                fr->slot[k] = -1;
         if (!fr->lane || !fr->pos || !fr->val || !fr->acc || !fr->done || !fr->reach || !fr->bad ||
             !fr->cb || !fr->hs || !fr->light_v || !fr->light_got || !fr->bws || !fr->sub_at ||
-            !fr->sub_lane || !fr->sub_pos || !fr->sub_lambda || !fr->sub_ok ||
+            !fr->sub_lane || !fr->sub_pos || !fr->sub_lambda || !fr->sub_ok || !fr->sub_of || !fr->slot ||
             lp_backward_create(&fr->bws[0], NULL) != LP_OK) {
             frame_free(fr);
             return NULL;
@@ -684,19 +692,23 @@ static int make_lane_tables(rs_integrator *it)
     return 0;
 }
 
-/* Colour c for use `kind` (see colour_entry) in lanes lane[0..n), at
- * [lane] of the array returned (the other lanes' values may be stale):
- * band_reflectance for the pigment and mirror colours, band_emission for
- * the others.  Valid until the next look-up of this kind. */
-static const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane, int n)
+/* lane_colour's entry of colour c (in the table of each use): the hash
+ * of its bits picks it. */
+static size_t colour_slot(const rs_worker *w, rs_color c)
 {
-    const rs_integrator *it = w->it;
     uint64_t u[3], h;
     memcpy(&u[0], &c.r, sizeof u[0]);
     memcpy(&u[1], &c.g, sizeof u[1]);
     memcpy(&u[2], &c.b, sizeof u[2]);
     h = (u[0] * 0x9E3779B97F4A7C15u) ^ (u[1] * 0xC2B2AE3D27D4EB4Fu) ^ (u[2] * 0x165667B19E3779F9u);
-    size_t e = (size_t)(h >> 58) & (w->cc_n - 1);
+    return (size_t)(h >> 58) & (w->cc_n - 1);
+}
+
+/* lane_colour where entry e does not yet hold c in every lane. */
+static const double *lane_colour_fill(rs_worker *w, int kind, size_t e, rs_color c,
+                                      const int *lane, int n)
+{
+    const rs_integrator *it = w->it;
     colour_entry *ce = &w->cc[kind][e];
     size_t at = ((size_t)kind * w->cc_n + e) * (size_t)it->n_lanes;
     double *v = w->cc_val + at;
@@ -723,16 +735,36 @@ static const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *
     return v;
 }
 
+/* Colour c for use `kind` (see colour_entry) in lanes lane[0..n), at
+ * [lane] of the array returned (the other lanes' values may be stale):
+ * band_reflectance for the pigment and mirror colours, band_emission for
+ * the others.  Valid until the next look-up of this kind.  Inline, the
+ * look-up of a colour held in every lane already (the usual case). */
+static inline const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane,
+                                        int n)
+{
+    size_t e = colour_slot(w, c);
+    const colour_entry *ce = &w->cc[kind][e];
+    if (ce->gen != 0 && ce->n_valid == w->it->n_lanes && memcmp(&ce->c, &c, sizeof c) == 0)
+        return w->cc_val + ((size_t)kind * w->cc_n + e) * (size_t)w->it->n_lanes;
+    return lane_colour_fill(w, kind, e, c, lane, n);
+}
+
 /* The parity (0 or 1) of floor(v + 1e-10) for any v: below 2^62 the
- * integer's own low bit (two's complement: -3 is odd too); beyond, where
- * a cast to long long would overflow, fmod, exact at every magnitude (a
- * double beyond 2^53 is an integer); not finite: 0. */
+ * integer's own low bit (two's complement: -3 is odd too), the floor
+ * taken as the cast's truncation, one less where that lies above (exact:
+ * the truncation of a double is a double); beyond, where a cast to long
+ * long would overflow, fmod, exact at every magnitude (a double beyond
+ * 2^53 is an integer); not finite: 0. */
 static int floor_parity(double v)
 {
-    double f = floor(v + 1e-10);
-    if (fabs(f) < 0x1p62)
-        return (int)((long long)f & 1);
-    double r = fmod(f, 2.0);
+    double x = v + 1e-10;
+    if (fabs(x) < 0x1p62) {
+        long long i = (long long)x;
+        i -= (double)i > x;
+        return (int)(i & 1);
+    }
+    double r = fmod(floor(x), 2.0);
     return r != 0.0 && r == r; /* -1 or 1: odd; NaN: 0 */
 }
 
@@ -833,12 +865,17 @@ static double light_reach(const rs_integrator *it, lp_vec3 x, int k)
         blocked = rs_bvh_any(sc->bvh, x, d, sg.eps, dist, shadow_meets, &sg);
     } else {
         rs_slab_ray r;
-        int boxes = sc->bvh && rs_bvh_object_count(sc->bvh) == sc->n_objects;
-        if (boxes)
-            rs_slab_ray_init(&r, x, d);
-        for (size_t i = 0; i < sc->n_objects && !blocked; i++)
-            if (!boxes || rs_bvh_may_meet(sc->bvh, (int)i, &r, sg.eps, dist))
-                blocked = shadow_meets(&sg, (int)i);
+        int boxes = sc->bvh && rs_bvh_object_count(sc->bvh) == sc->n_objects, ready = 0;
+        for (size_t i = 0; i < sc->n_objects && !blocked; i++) {
+            if (boxes && rs_bvh_culls(sc->bvh, (int)i)) { /* the ray for boxes, once needed */
+                if (!ready)
+                    rs_slab_ray_init(&r, x, d);
+                ready = 1;
+                if (!rs_bvh_may_meet(sc->bvh, (int)i, &r, sg.eps, dist))
+                    continue;
+            }
+            blocked = shadow_meets(&sg, (int)i);
+        }
     }
     if (blocked)
         return 0.0;
@@ -1068,7 +1105,7 @@ static int lens_args(const rs_integrator *it, int level, double weight, lp_trace
 }
 
 /* A lens hit of the packet lane[0..n) at lens `object` along (o, d): its
- * sub-packets (lanes of equal optics there, rs_packet_next, in the
+ * sub-packets (lanes of equal optics there, rs_packet_split, in the
  * frame's sub_ arrays) and their backward builds, made at once -- at a
  * dispersive lens, one lp_backward_build_many for the sub-packets'
  * wavelengths, each build exactly lp_backward_build's.  lens_next then
@@ -1076,21 +1113,18 @@ static int lens_args(const rs_integrator *it, int level, double weight, lp_trace
 static int lens_builds(const rs_integrator *it, frame *fr, const rs_object *ob, int object,
                        const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a)
 {
-    int m, ns = 0, at = 0;
-    memset(fr->done, 0, (size_t)n);
-    while ((m = rs_packet_next(it->classes, object, lane, n, fr->done, fr->sub_pos + at)) > 0) {
-        if (ns == fr->n_bws) {
-            if (lp_backward_create(&fr->bws[ns], NULL) != LP_OK)
+    int ns = rs_packet_split(it->classes, object, lane, n, fr->sub_at, fr->sub_pos, fr->sub_of,
+                             fr->slot);
+    for (int s = 0; s < ns; s++) {
+        if (s == fr->n_bws) {
+            if (lp_backward_create(&fr->bws[s], NULL) != LP_OK)
                 return -1;
             fr->n_bws++;
         }
-        fr->sub_at[ns] = at;
-        for (int k = 0; k < m; k++)
-            fr->sub_lane[at + k] = lane[fr->sub_pos[at + k]];
-        fr->sub_lambda[ns++] = it->lanes[fr->sub_lane[at]].lambda;
-        at += m;
+        for (int k = fr->sub_at[s]; k < fr->sub_at[s + 1]; k++)
+            fr->sub_lane[k] = lane[fr->sub_pos[k]];
+        fr->sub_lambda[s] = it->lanes[fr->sub_lane[fr->sub_at[s]]].lambda;
     }
-    fr->sub_at[ns] = at;
     fr->n_sub = ns;
     fr->sub_next = 0;
     int all = ns > 1 && lp_backward_build_many(fr->bws, (size_t)ns, ob->lens, o, d,
@@ -1135,26 +1169,41 @@ static void trace_scalar(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec
     trace_scalar_hit(w, lane, n, o, d, found ? &h : NULL, level, weight, f, out);
 }
 
-/* Where query q of a lens hit's sub-packet meets the scene (NULL:
- * nowhere).  The reflection off the outside (depth 1) does not depend on
- * the wavelength: its hit is kept for the next sub-packet of the same lens
- * hit (a dispersive lens splits every lane off), which meets the scene
- * at the same point when its ray is the same. */
-static const rs_hit *query_hit(const rs_scene *sc, frame *fr, const lp_query *q)
+/* Where query j of a lens hit's sub-packet meets the scene (NULL:
+ * nowhere).  The lens hit was object `object` (a lens of the scene's own
+ * list, or a CSG's member: -1): where the build certifies that the query
+ * ray cannot meet its lens again (lp_backward_query_leaves), the lens is
+ * left out of the test, which finds the same hit.  The reflection off the
+ * outside (depth 1) does not depend on the wavelength: its hit is kept for
+ * the next sub-packet of the same lens hit (a dispersive lens splits every
+ * lane off), which meets the scene at the same point when its ray is the
+ * same. */
+static const rs_hit *query_hit(const rs_scene *sc, frame *fr, const lp_query *q, size_t j,
+                               int object)
 {
     query_memo *m = &fr->qm;
+    q += j;
     if (q->depth != 1) {
-        int found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h_other);
+        int skip = object >= 0 && lp_backward_query_leaves(fr->bw, j) ? object : -1;
+        int found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, skip, &m->h_other);
         return found ? &m->h_other : NULL;
     }
     if (!m->valid || memcmp(&m->origin, &q->origin, sizeof m->origin) != 0 ||
         memcmp(&m->dir, &q->dir, sizeof m->dir) != 0) {
+        int skip = object >= 0 && lp_backward_query_leaves(fr->bw, j) ? object : -1;
         m->origin = q->origin;
         m->dir = q->dir;
-        m->found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, -1, &m->h);
+        m->found = rs_scene_intersect(sc, q->origin, q->dir, 0.0, INFINITY, skip, &m->h);
         m->valid = 1;
     }
     return m->found ? &m->h : NULL;
+}
+
+/* The object index of a lens hit h for query_hit: h.object when the lens
+ * is that object itself, -1 when it is a member of it (a CSG). */
+static int lens_object(const rs_scene *sc, const rs_hit *h)
+{
+    return &sc->objects[h->object] == h->surface ? h->object : -1;
 }
 
 /* trace_scalar once the ray's hit is known (NULL: it meets nothing). */
@@ -1191,7 +1240,8 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
             for (int k = 0; k < m; k++)
                 fr->acc[k] = 0.0;
             for (size_t j = 0; j < nq; j++) {
-                trace_scalar_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
+                trace_scalar_hit(w, fr->lane, m, q[j].origin, q[j].dir,
+                                 query_hit(sc, fr, q, j, lens_object(sc, &h)),
                                  level + q[j].depth, weight * q[j].weight, f + 1, fr->val);
                 for (int k = 0; k < m; k++)
                     fr->acc[k] += q[j].weight * fr->val[k];
@@ -1674,7 +1724,8 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
             w->work.builds += 1.0;
             for (size_t j = 0; j < nq; j++) {
                 bundle_clear(&fr->child);
-                trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir, query_hit(sc, fr, &q[j]),
+                trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir,
+                              query_hit(sc, fr, q, j, lens_object(sc, &h)),
                               level + q[j].depth, weight * q[j].bound, f + 1, &fr->child);
                 if (fr->child.n == 0)
                     continue;

@@ -93,19 +93,47 @@ int rs_lane_class(const rs_lane_classes *c, int object, int lane)
     return c->cls[(size_t)object * (size_t)c->n_lanes + (size_t)lane];
 }
 
-int rs_packet_next(const rs_lane_classes *c, int object, const int *lane, int n,
-                   unsigned char *done, int *pos)
+int rs_packet_split(const rs_lane_classes *c, int object, const int *lane, int n, int *at,
+                    int *pos, int *sub, int *slot)
 {
-    int first = 0, m = 0;
-    while (first < n && done[first])
-        first++;
-    if (first == n)
-        return 0;
-    int cls = rs_lane_class(c, object, lane[first]);
-    for (int k = first; k < n; k++)
-        if (!done[k] && rs_lane_class(c, object, lane[k]) == cls) {
-            done[k] = 1;
-            pos[m++] = k;
+    /* rs_lane_class's look-ups, with the object's row found once */
+    const int *row = object >= 0 && (size_t)object < c->n_objects
+                         ? &c->cls[(size_t)object * (size_t)c->n_lanes]
+                         : NULL;
+    int nl = c->n_lanes, ns = 0;
+    for (int k = 0; k < n; k++) {
+        int l = lane[k];
+        int cls = row && l >= 0 && l < nl ? row[l] : l;
+        if (cls < 0 || cls >= nl) { /* not a lane: alone (no slot) */
+            at[ns] = 0;
+            sub[k] = ns++;
+            continue;
         }
-    return m;
+        if (slot[cls] < 0) {
+            at[ns] = 0;
+            slot[cls] = ns++;
+        }
+        sub[k] = slot[cls];
+    }
+    /* at[s]: sub-packet s's size, then where it starts */
+    for (int k = 0; k < n; k++)
+        at[sub[k]]++;
+    for (int s = 0, start = 0; s <= ns; s++) {
+        int size = s < ns ? at[s] : 0;
+        at[s] = start;
+        start += size;
+    }
+    for (int k = 0; k < n; k++) {
+        int l = lane[k];
+        int cls = row && l >= 0 && l < nl ? row[l] : l;
+        if (cls >= 0 && cls < nl)
+            slot[cls] = -1;
+    }
+    /* the members in order, each sub-packet filled from its start */
+    for (int k = 0; k < n; k++)
+        pos[at[sub[k]]++] = k;
+    for (int s = ns; s > 0; s--) /* at[s] was moved to the end of s: back */
+        at[s] = at[s - 1];
+    at[0] = 0;
+    return ns;
 }

@@ -33,11 +33,13 @@ void rs_lane_classes_destroy(rs_lane_classes *c); /* NULL: no-op */
  * lens: every lane is alike there). */
 int rs_lane_class(const rs_lane_classes *c, int object, int lane);
 
-/* The next sub-packet of lane[0..n) at object i: the first lane not yet
- * done and every later one of its class, in order.  Writes their
- * positions in lane[] to pos[] and marks them done; returns how many (0
- * when all are done). */
-int rs_packet_next(const rs_lane_classes *c, int object, const int *lane, int n,
-                   unsigned char *done, int *pos);
+/* The sub-packets of lane[0..n) at object i: the first lane and every
+ * later one of its class, then the first lane left and its class, and so
+ * on.  Sub-packet s holds the positions in lane[] pos[at[s] .. at[s+1]),
+ * in order; returns how many sub-packets (at[] has one more entry).  sub
+ * is scratch for n entries; slot for n_lanes entries, every one -1 on
+ * entry, and so again on return.  O(n). */
+int rs_packet_split(const rs_lane_classes *c, int object, const int *lane, int n, int *at,
+                    int *pos, int *sub, int *slot);
 
 #endif

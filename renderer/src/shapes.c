@@ -196,12 +196,17 @@ int rs_scene_intersect(const rs_scene *scene, lp_vec3 origin, lp_vec3 dir, doubl
     rs_slab_ray r;
     if (rs_bvh_serves(scene->bvh, scene))
         return rs_bvh_intersect(scene->bvh, scene, origin, dir, t_min, t_max, skip, hit);
-    int boxes = scene->bvh && rs_bvh_object_count(scene->bvh) == scene->n_objects;
-    if (boxes)
-        rs_slab_ray_init(&r, origin, dir);
+    int boxes = scene->bvh && rs_bvh_object_count(scene->bvh) == scene->n_objects, ready = 0;
     for (size_t i = 0; i < scene->n_objects; i++) {
-        if ((int)i == skip || (boxes && !rs_bvh_may_meet(scene->bvh, (int)i, &r, t_min, t_max)))
+        if ((int)i == skip)
             continue;
+        if (boxes && rs_bvh_culls(scene->bvh, (int)i)) { /* the ray for boxes, once needed */
+            if (!ready)
+                rs_slab_ray_init(&r, origin, dir);
+            ready = 1;
+            if (!rs_bvh_may_meet(scene->bvh, (int)i, &r, t_min, t_max))
+                continue;
+        }
         if (rs_object_intersect(&scene->objects[i], origin, dir, t_min, t_max, &h)) {
             h.object = (int)i;
             *hit = h;

@@ -15,7 +15,9 @@
  *            the filter's calls (every argument, in order) and the result
  *            of gathering two bundle rays through every query (every
  *            outgoing ray as bytes and every sum) must be identical.  The
- *            contract is exactness, so the tolerance is 0.
+ *            contract is exactness, so the tolerance is 0.  A query
+ *            lp_backward_query_leaves says leaves its lens must have no
+ *            hit of lp_lens_intersect, and both builds must say the same.
  * errors     NULL arguments; a NULL builder, an invalid wavelength, bad
  *            args, a view ray that is not finite or has no direction: the
  *            first failing build's status and message, prefixed with its
@@ -146,7 +148,7 @@ static int same_build(const lp_backward *a, const lp_backward *b, double lambda_
 }
 
 static lp_backward *one[MAX_WL], *many[MAX_WL];
-static int n_cases, n_builds, n_queries, n_rim;
+static int n_cases, n_builds, n_queries, n_rim, n_leaves;
 
 /* One view ray at wavelengths lambda[0..n): many vs one by one. */
 static void identity_case(const char *name, const lp_lens *lens, lp_vec3 o, lp_vec3 d,
@@ -169,14 +171,26 @@ static void identity_case(const char *name, const lp_lens *lens, lp_vec3 o, lp_v
           err.message);
     CHECK(same_calls(&log_one, &log_many), "%s: the filter's calls (%zu / %zu)", name,
           log_one.n, log_many.n);
-    size_t differ = 0;
+    size_t differ = 0, wrong = 0;
     for (size_t k = 0; k < n; k++) {
         differ += !same_build(one[k], many[k], lambda[k]);
+        /* lp_backward_query_leaves: the same for both builds, and where it
+         * says so, the lens really has no hit along the query ray */
+        const lp_query *q = lp_backward_queries(many[k]);
+        for (size_t j = 0; j < lp_backward_query_count(many[k]); j++) {
+            int leaves = lp_backward_query_leaves(many[k], j);
+            lp_hit h;
+            differ += leaves != lp_backward_query_leaves(one[k], j);
+            wrong += leaves && lp_lens_intersect(lens, q[j].origin, q[j].dir, 0.0, INFINITY, &h);
+            n_leaves += leaves;
+        }
         n_queries += (int)lp_backward_query_count(many[k]);
         n_rim += lp_backward_rim_depth(many[k]) > 0;
     }
     CHECK(differ == 0, "%s mode %d depth %d: %zu of %zu wavelengths differ", name,
           (int)args->mode, args->max_depth, differ, n);
+    CHECK(wrong == 0, "%s mode %d depth %d: %zu queries said to leave the lens meet it", name,
+          (int)args->mode, args->max_depth, wrong);
     n_cases++;
     n_builds += (int)n;
 }
@@ -285,8 +299,10 @@ static void test_identity(void)
         lp_lens_destroy(lens);
     }
     printf("identity: %d calls, %d builds, %d queries (%d with a rim depth), every query, "
-           "filter call and gather identical to lp_backward_build's\n",
-           n_cases, n_builds, n_queries, n_rim);
+           "filter call and gather identical to lp_backward_build's; %d queries leave "
+           "their lens, none of them meets it\n",
+           n_cases, n_builds, n_queries, n_rim, n_leaves);
+    CHECK(n_leaves > 0, "some query leaves its lens");
 }
 
 static void test_errors(void)
