@@ -1905,13 +1905,13 @@ double rs_work_cost(const rs_work *w, rs_mode mode, double pixels)
     /* bench/work_cost_fit.sh prints this body */
     switch (mode) {
     case RS_MODE_POLARIZED:
-        return 2248.3 * w->rays + 135.3 * w->lane_rays + 1311.7 * w->gathered + 1258.4 * pixels;
+        return 1930.0 * w->rays + 134.2 * w->lane_rays + 1171.0 * w->gathered + 1761.5 * pixels;
     case RS_MODE_FRESNEL:
-        return 1983.3 * w->rays + 96.1 * w->lane_rays + 198.0 * w->builds + 966.5 * pixels;
+        return 1558.1 * w->rays + 98.9 * w->lane_rays + 6.8 * w->builds + 1445.8 * pixels;
     case RS_MODE_SCHLICK:
-        return 1975.9 * w->rays + 96.6 * w->lane_rays + 221.5 * w->builds + 968.0 * pixels;
+        return 1553.3 * w->rays + 99.3 * w->lane_rays + 16.3 * w->builds + 1447.7 * pixels;
     case RS_MODE_RGB:
-        return 2091.7 * w->rays + 1205.5 * pixels;
+        return 1894.0 * w->rays + 11.6 * w->lane_rays + 1272.5 * pixels;
     }
     return 0.0;
 }

@@ -73,12 +73,12 @@ void rs_worker_work(const rs_worker *w, rs_work *out);
  * the relative error) of callgrind's counts of the pixels of 560 renders
  * (14 shipped scenes, every mode, 4-64 wavelengths, depth 4 and 16,
  * cut-off 1e-3 and 1e-6, 24 x 18 pixels, 12 x 9 for the 3 slowest, one
- * thread), 0.07-1.55 times the count, 32 % RMS.  What the counters miss
+ * thread), 0.06-1.48 times the count, 34 % RMS.  What the counters miss
  * is mostly a scene's own: its intersections' and its lens builds' cost
- * (the geometric mean of predicted / count is 0.17 on michel_levy's
- * crystal, 0.49 on machined_parts' CSG, 0.66-1.32 on the others); divided
+ * (the geometric mean of predicted / count is 0.14 on michel_levy's
+ * crystal, 0.46 on machined_parts' CSG, 0.58-1.29 on the others); divided
  * by that factor, which auto's comparisons of one scene's settings do not
- * see, 0.40-1.57 times the count, 15 % RMS.  bench/work_cost_fit.sh
+ * see, 0.42-1.60 times the count, 15.5 % RMS.  bench/work_cost_fit.sh
  * reproduces the fit and prints this function's body.
  * Deterministic: it prices what a render will cost on any machine. */
 double rs_work_cost(const rs_work *w, rs_mode mode, double pixels);
