@@ -96,9 +96,12 @@ lp__exit lp__exit_at(const lp_lens *lens, lp_vec3 p, lp_vec3 d)
     return x;
 }
 
-lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, double power,
-                         const lp__exit *x, const lp__payload *pl, int depth, lp_kind kind,
-                         int surface, uint64_t path, lp_error *err)
+/* The rays of field E (power `power`) leaving at x, each with the wave
+ * bits `waves`: lp__emit_power and lp__emit_gathered in one pass. */
+static inline lp_status emit_parts(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
+                                   double power, const lp__exit *x, const lp__payload *pl,
+                                   int depth, lp_kind kind, int surface, uint64_t path,
+                                   uint64_t waves, lp_error *err)
 {
     lp__linear_part part[2];
     int n = lp__field_split(E, power, x->d, part);
@@ -121,10 +124,17 @@ lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E
         o->surface = surface;
         o->part = k;
         o->path = path;
-        o->waves = 0;
+        o->waves = waves;
         res->out += part[k].intensity;
     }
     return LP_OK;
+}
+
+lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, double power,
+                         const lp__exit *x, const lp__payload *pl, int depth, lp_kind kind,
+                         int surface, uint64_t path, lp_error *err)
+{
+    return emit_parts(lens, res, E, power, x, pl, depth, kind, surface, path, 0, err);
 }
 
 lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
@@ -174,12 +184,10 @@ lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3
                             double in, double absorbed, lp_error *err)
 {
     double before = res->out;
-    size_t first = res->count;
-    lp_status st = lp__emit(lens, res, E, x, pl, q->depth, q->kind, q->surface, q->path, err);
+    lp_status st = emit_parts(lens, res, E, cv3_norm2(*E), x, pl, q->depth, q->kind, q->surface,
+                              q->path, q->waves, err);
     if (st != LP_OK)
         return st;
-    for (size_t i = first; i < res->count; i++)
-        res->rays[i].waves = q->waves;
     res->absorbed_glass += absorbed;
     res->truncated += in - (res->out - before) - absorbed;
     return LP_OK;
