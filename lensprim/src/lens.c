@@ -99,6 +99,7 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
     double z1e = lp__cap_sag(c1, h1);
     double z2e = t + lp__cap_sag(c2, h2);
     double edge = z2e - z1e;
+    double slack = 1e-12 * (edge + h1 + h2); /* the rim's */
 
     lens = calloc(1, sizeof *lens);
     if (!lens)
@@ -117,7 +118,7 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
                             "the caps cross before the rim: edge thickness %g mm", edge);
         }
         if (edge > tol) {
-            lens->rim = (lp__rim){1, z1e, h1, z2e, h2, 0.0};
+            lens->rim = (lp__rim){1, z1e, h1, z2e, h2, 0.0, slack};
         } else {
             lens->rim.present = 0; /* knife edge */
         }
@@ -128,7 +129,7 @@ lp_status lp_lens_create(const lp_lens_desc *desc, lp_lens **out, lp_error *err)
                             "a conical rim (D2 != D) needs a positive edge thickness, got %g mm",
                             edge);
         }
-        lens->rim = (lp__rim){1, z1e, h1, z2e, h2, (h2 - h1) / edge};
+        lens->rim = (lp__rim){1, z1e, h1, z2e, h2, (h2 - h1) / edge, slack};
         /* The cone must stay behind the wider cap between the two edges. */
         for (int i = 1; i < 64; i++) {
             double f = i / 64.0;
@@ -232,10 +233,16 @@ int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
         }
     }
     lp_vec3 x = v3_madd(p, d, best);
-    int rim_possible = lens->rim.present &&
-                       !(from_surface != LP_SURFACE_NONE && surface != LP_SURFACE_NONE &&
-                         inside_rim(&lens->rim, p) && inside_rim(&lens->rim, x));
-    if (rim_possible && lp__rim_intersect(&lens->rim, p, d, t_other, best, &t)) {
+    /* The rim's test is skipped where it cannot find a hit: a segment
+     * between two cap points inside the rim's solid, or a ray meeting no
+     * cap that leaves the rim's z range behind. */
+    const lp__rim *rim = &lens->rim;
+    int rim_possible =
+        rim->present && (surface == LP_SURFACE_NONE
+                             ? !(t_other >= 0.0 && lp__rim_beyond(rim, p, d))
+                             : !(from_surface != LP_SURFACE_NONE && inside_rim(rim, p) &&
+                                 inside_rim(rim, x)));
+    if (rim_possible && lp__rim_intersect(rim, p, d, t_other, best, &t)) {
         best = t;
         surface = LP_SURFACE_RIM;
         x = v3_madd(p, d, best);
@@ -245,7 +252,7 @@ int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
     hit->t = best;
     hit->p = x;
     hit->surface = surface;
-    hit->n = surface == LP_SURFACE_RIM ? lp__rim_normal(&lens->rim, hit->p)
+    hit->n = surface == LP_SURFACE_RIM ? lp__rim_normal(rim, hit->p)
                                        : lp__cap_normal(&lens->cap[surface], hit->p);
     return 1;
 }
@@ -272,6 +279,16 @@ int lp__lens_surface_at(const lp_lens *lens, lp_vec3 p)
     return LP_SURFACE_NONE;
 }
 
+/* The ray origin + t d (d unit, world) in the local frame: *p and *dl,
+ * and the surface the origin lies on. */
+static inline int local_ray(const lp_lens *lens, lp_vec3 origin, lp_vec3 d, lp_vec3 *p,
+                            lp_vec3 *dl)
+{
+    *p = lp__to_local_point(lens, origin);
+    *dl = lp__to_local_dir(lens, d);
+    return lp__lens_surface_at(lens, *p);
+}
+
 int lp_lens_intersect(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir, double t_min,
                       double t_max, lp_hit *hit)
 {
@@ -287,15 +304,25 @@ int lp_lens_intersect(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir, double t
     double b = v3_dot(oc, d), c = v3_dot(oc, oc) - lens->bound_r2;
     if (c > 0.0 && (b > 0.0 || b * b < c))
         return 0;
-    lp_vec3 p = lp__to_local_point(lens, origin);
-    if (!lp__lens_hit(lens, p, lp__to_local_dir(lens, d), lp__lens_surface_at(lens, p), t_min,
-                      t_max, &h))
+    lp_vec3 p, dl;
+    int from = local_ray(lens, origin, d, &p, &dl);
+    if (!lp__lens_hit(lens, p, dl, from, t_min, t_max, &h))
         return 0;
     hit->t = h.t;
     hit->point = v3_madd(origin, d, h.t);
     hit->normal = lp__to_world_dir(lens, h.n);
     hit->surface = h.surface;
     return 1;
+}
+
+int lp__lens_leaves(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir)
+{
+    lp__local_hit h;
+    lp_vec3 p, dl;
+    int from = local_ray(lens, origin, v3_normalize(dir), &p, &dl);
+    if (from != LP_SURFACE_FRONT && from != LP_SURFACE_BACK)
+        return 0;
+    return !lp__lens_hit(lens, p, dl, from, 0.0, INFINITY, &h);
 }
 
 int lp_lens_contains(const lp_lens *lens, lp_vec3 point)

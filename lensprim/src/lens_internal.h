@@ -25,6 +25,8 @@ typedef struct lp__rim {
     double z_a, rho_a; /* one edge circle */
     double z_b, rho_b; /* the other; z_a < z_b */
     double k;          /* d rho / d z */
+    double slack;      /* how far past z_a .. z_b a hit is still taken:
+                          1e-12 (z_b - z_a + rho_a + rho_b) */
 } lp__rim;
 
 struct lp_lens {
@@ -65,9 +67,21 @@ static inline lp_vec3 lp__cap_normal(const lp__cap *cap, lp_vec3 p)
     return v3_scale(v3_normalize(n), cap->out);
 }
 
+/* The smallest t in (t_min, t_max) where p + t d meets the rim, within
+ * its z range widened by its slack.  Returns 1 on a hit. */
 int lp__rim_intersect(const lp__rim *rim, lp_vec3 p, lp_vec3 d, double t_min,
                       double t_max, double *t);
 lp_vec3 lp__rim_normal(const lp__rim *rim, lp_vec3 p);
+
+/* Whether lp__rim_intersect(rim, p, d, t_min, ...) with t_min >= 0
+ * certainly finds nothing because p lies beyond the rim's z range and d
+ * leads away from it: a root's z = p.z + s d.z with s > 0 stays on p's
+ * side of p.z (rounding is monotonic), so the test refuses every root. */
+static inline int lp__rim_beyond(const lp__rim *rim, lp_vec3 p, lp_vec3 d)
+{
+    return ((d.z <= 0.0) & (p.z < rim->z_a - rim->slack)) |
+           ((d.z >= 0.0) & (p.z > rim->z_b + rim->slack)); /* free of branches (lanes.h) */
+}
 
 /* Nearest hit of the local ray p + t d, t in (t_min, t_max), with the
  * whole surface.  from_surface is the surface p lies on (LP_SURFACE_NONE
@@ -80,6 +94,16 @@ int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
  * use it so that a ray starting on the lens (say, one it just emitted)
  * never meets its own origin again. */
 int lp__lens_surface_at(const lp_lens *lens, lp_vec3 p);
+
+/* Whether lp_lens_intersect(lens, origin, dir, 0, t_max) certainly
+ * returns 0 for every t_max: that call's own arithmetic (the local ray,
+ * the surface it leaves, lp__lens_hit) with t_max = INFINITY; with no hit
+ * there, there is none below any t_max (every test only narrows).  Where
+ * that call would not look at the caps (a ray not finite, of no
+ * direction, or away from the lens's bounding sphere) it returns 0
+ * anyway, so any answer is right there.  0 where not certain (a ray from
+ * no cap). */
+int lp__lens_leaves(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir);
 
 /* World <-> local (inline: every node and outgoing ray uses them). */
 static inline lp_vec3 lp__to_local_dir(const lp_lens *lens, lp_vec3 d)

@@ -45,7 +45,7 @@ int lp__rim_intersect(const lp__rim *rim, lp_vec3 p, lp_vec3 d, double t_min,
             roots[1] = tmp;
         }
     }
-    double slack = 1e-12 * (rim->z_b - rim->z_a + rim->rho_a + rim->rho_b);
+    double slack = rim->slack;
     for (int i = 0; i < n; i++) {
         double s = roots[i];
         if (!(s > t_min && s < t_max))

@@ -20,7 +20,6 @@
 #include <stdlib.h>
 
 #include "backward.h"
-#include "cap.h"
 #include "error.h"
 #include "interface.h"
 
@@ -63,47 +62,13 @@ int lp_backward_rim_depth(const lp_backward *bw)
     return bw ? bw->rim_depth : 0;
 }
 
-/* Whether lp_lens_intersect(lens, origin, dir, 0, t_max) certainly
- * returns 0 for every t_max.  Where that call would not look at the
- * caps (a ray not finite, of no direction, or away from the lens's
- * bounding sphere) it returns 0 anyway, so any answer is right there; else
- * this is the same arithmetic as that call with t_max = INFINITY (lens.c:
- * the local ray, the surface it leaves, each cap; its steps in the same
- * order, so every number is the same), but that the rim's test is
- * skipped where no root can pass its z range (a ray from below it going
- * down, or from above it going up: p.z + s d.z with s > 0 stays on p's
- * side of it).  With no hit at t_max = INFINITY there is none below any
- * t_max: every test only narrows.  0 where not certain (a ray from no
- * cap). */
-static int leaves_lens(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir)
-{
-    lp_vec3 d = v3_normalize(dir);
-    lp_vec3 p = lp__to_local_point(lens, origin), dl = lp__to_local_dir(lens, d);
-    int from = lp__lens_surface_at(lens, p);
-    if (from != LP_SURFACE_FRONT && from != LP_SURFACE_BACK)
-        return 0;
-    double t, t_other = lp__max(0.0, lens->eps);
-    for (int s = LP_SURFACE_FRONT; s <= LP_SURFACE_BACK; s++) {
-        int self = s == from;
-        if (lp__cap_intersect(&lens->cap[s], p, dl, self, self ? 0.0 : t_other, INFINITY, &t))
-            return 0;
-    }
-    const lp__rim *rim = &lens->rim;
-    if (!rim->present)
-        return 1;
-    double slack = 1e-12 * (rim->z_b - rim->z_a + rim->rho_a + rim->rho_b); /* rim.c's */
-    if ((dl.z <= 0.0 && p.z < rim->z_a - slack) || (dl.z >= 0.0 && p.z > rim->z_b + slack))
-        return 1;
-    return !lp__rim_intersect(rim, p, dl, t_other, INFINITY, &t);
-}
-
 int lp_backward_query_leaves(const lp_backward *bw, size_t q)
 {
     if (!bw || lp__xback_active(bw->xb) || q >= bw->n_queries)
         return 0;
     if (bw->leaves[q] >= 0)
         return bw->leaves[q];
-    return leaves_lens(bw->lens, bw->query[q].origin, bw->query[q].dir);
+    return lp__lens_leaves(bw->lens, bw->query[q].origin, bw->query[q].dir);
 }
 
 /* Power factors of a node for the bound (max over s/p) and the
