@@ -32,6 +32,7 @@
 #include <string.h>
 
 #include "check.h"
+#include "splitmix.h"
 #include "same_bits.h"
 #include "lensprim.h"
 
@@ -41,11 +42,7 @@
 static uint64_t rng = 0xb4c3a11e5ull;
 static double uniform(void)
 {
-    uint64_t z = (rng += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    z ^= z >> 31;
-    return (z >> 11) * (1.0 / 9007199254740992.0);
+    return splitmix_uniform(&rng);
 }
 
 static lp_vec3 vec(double x, double y, double z)
