@@ -74,10 +74,6 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
                     const struct lp__branch *b, lp_vec3 p, const lp__payload *pl, int depth,
                     lp_kind kind, int surface, uint64_t path, lp_error *err);
 
-/* Check a bundle ray of lp_backward_gather and give its field direction
- * in the lens frame, perpendicular to the local light direction. */
-lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,
-                               lp_vec3 *vp, lp_error *err);
 
 /* Emit a gathered field E (of a bundle ray of power `in`, of which
  * `absorbed` went into the glass) as the rays of query q, leaving the
@@ -107,6 +103,29 @@ static inline int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
         return 0;
     *out = u;
     return 1;
+}
+
+/* Report in err what is wrong with a bundle ray that fails
+ * lp__bundle_ray_check (LP_ERROR_INVALID_ARGUMENT): its intensity, op or
+ * phase (what 0), or its polarization (what 1). */
+void lp__bundle_ray_fail(int what, lp_error *err);
+
+/* Check a bundle ray of lp_backward_gather and give its field direction
+ * in the lens frame, perpendicular to the local light direction (inline:
+ * every gathered ray is checked). */
+static inline lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b,
+                                             lp_vec3 light, lp_vec3 *vp, lp_error *err)
+{
+    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
+        !isfinite(b->phase)) {
+        lp__bundle_ray_fail(0, err);
+        return LP_ERROR_INVALID_ARGUMENT;
+    }
+    if (!v3_finite(b->vp) || !lp__perp_unit(lp__to_local_dir(lens, b->vp), light, vp)) {
+        lp__bundle_ray_fail(1, err);
+        return LP_ERROR_INVALID_ARGUMENT;
+    }
+    return LP_OK;
 }
 
 /* Check a forward input ray: its unit direction *d and the unit field

@@ -166,17 +166,14 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
     return lp__emit_power(lens, res, &b->E, power, &x, pl, depth, kind, surface, path, err);
 }
 
-lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,
-                               lp_vec3 *vp, lp_error *err)
+void lp__bundle_ray_fail(int what, lp_error *err)
 {
-    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
-        !isfinite(b->phase))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
-    if (!v3_finite(b->vp) || !lp__perp_unit(lp__to_local_dir(lens, b->vp), light, vp))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray polarization must be finite and not parallel to the query ray");
-    return LP_OK;
+    if (what == 0)
+        lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                 "bundle ray intensity, op and phase must be finite (intensity >= 0)");
+    else
+        lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                 "bundle ray polarization must be finite and not parallel to the query ray");
 }
 
 lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
