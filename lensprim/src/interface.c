@@ -21,19 +21,6 @@ static lp_vec3 hint_axis(lp_vec3 d, const lp__cvec3 *hint)
     return v3_dot(e, e) > 0.0 ? v3_normalize(e) : v3_any_perp(d);
 }
 
-int lp__node_setup_fresnel(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2)
-{
-    double dn = v3_dot(d, normal);
-    double adn = fabs(dn);
-    node->d = d;
-    node->n1 = n1;
-    node->n2 = n2;
-    node->n = dn > 0.0 ? v3_neg(normal) : normal;
-    node->cos_i = adn < 1.0 ? adn : 1.0;
-    lp__fresnel_eval(node->cos_i, n1, n2, &node->f);
-    return node->f.tir;
-}
-
 int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
                    const lp__cvec3 *hint)
 {
@@ -54,17 +41,6 @@ void lp__node_refit(lp__node *node, const lp__cvec3 *E)
     }
 }
 
-lp_vec3 lp__node_reflect_dir(const lp__node *node)
-{
-    return v3_normalize(v3_madd(node->d, node->n, 2.0 * node->cos_i));
-}
-
-lp_vec3 lp__node_transmit_dir(const lp__node *node)
-{
-    double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
-    return v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
-}
-
 double lp__node_reflectance(const lp__node *node, lp_mode mode)
 {
     if (node->f.tir)
@@ -80,18 +56,6 @@ static lp__cvec3 combine(int real, double complex a, lp_vec3 u, double complex b
     if (real)
         return cv3_real(v3_add(v3_scale(u, creal(a)), v3_scale(w, creal(b))), 1.0);
     return cv3_combine(a, u, b, w);
-}
-
-static inline void reflect_axes(const lp__node *node, lp__axes *ax)
-{
-    ax->dir = lp__node_reflect_dir(node);
-    ax->p = v3_cross(ax->dir, node->s);
-}
-
-static inline void transmit_axes(const lp__node *node, lp__axes *ax)
-{
-    ax->dir = lp__node_transmit_dir(node);
-    ax->p = v3_cross(ax->dir, node->s);
 }
 
 static inline void reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
@@ -148,12 +112,14 @@ static inline void transmit_on(const lp__node *node, const lp__axes *ax, lp_mode
 
 void lp__node_reflect_axes(const lp__node *node, lp__axes *ax)
 {
-    reflect_axes(node, ax);
+    ax->dir = lp__node_reflect_dir(node);
+    ax->p = v3_cross(ax->dir, node->s);
 }
 
 void lp__node_transmit_axes(const lp__node *node, lp__axes *ax)
 {
-    transmit_axes(node, ax);
+    ax->dir = lp__node_transmit_dir(node);
+    ax->p = v3_cross(ax->dir, node->s);
 }
 
 void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,
@@ -172,7 +138,7 @@ void lp__node_reflect_amp(const lp__node *node, lp_mode mode, const lp__amp *amp
                           lp__branch *out)
 {
     lp__axes ax;
-    reflect_axes(node, &ax);
+    lp__node_reflect_axes(node, &ax);
     reflect_on(node, &ax, mode, amp, out);
 }
 
@@ -180,7 +146,7 @@ void lp__node_transmit_amp(const lp__node *node, lp_mode mode, const lp__amp *am
                            lp__branch *out)
 {
     lp__axes ax;
-    transmit_axes(node, &ax);
+    lp__node_transmit_axes(node, &ax);
     transmit_on(node, &ax, mode, amp, out);
 }
 

@@ -50,13 +50,34 @@ int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double 
 
 /* The geometry and Fresnel factors of lp__node_setup alone (no s and p
  * axes: for the directions and powers of the branches, not their
- * fields).  Returns 1 under total internal reflection. */
-int lp__node_setup_fresnel(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2);
+ * fields).  Returns 1 under total internal reflection.  Inline, as the
+ * two below: every node of a build and every way of a gather sets up. */
+static inline int lp__node_setup_fresnel(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1,
+                                         double n2)
+{
+    double dn = v3_dot(d, normal);
+    double adn = fabs(dn);
+    node->d = d;
+    node->n1 = n1;
+    node->n2 = n2;
+    node->n = dn > 0.0 ? v3_neg(normal) : normal;
+    node->cos_i = adn < 1.0 ? adn : 1.0;
+    lp__fresnel_eval(node->cos_i, n1, n2, &node->f);
+    return node->f.tir;
+}
 
 /* The unit directions of the reflected and (not under TIR) transmitted
  * branches: those of lp__node_reflect and lp__node_transmit. */
-lp_vec3 lp__node_reflect_dir(const lp__node *node);
-lp_vec3 lp__node_transmit_dir(const lp__node *node);
+static inline lp_vec3 lp__node_reflect_dir(const lp__node *node)
+{
+    return v3_normalize(v3_madd(node->d, node->n, 2.0 * node->cos_i));
+}
+
+static inline lp_vec3 lp__node_transmit_dir(const lp__node *node)
+{
+    double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
+    return v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
+}
 
 /* A node set up once for any field (hint NULL) serves every field, except
  * at normal incidence, where the s axis follows the field: this redoes

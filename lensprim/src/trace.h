@@ -3,7 +3,10 @@
 #define LP_TRACE_H
 
 #include "cvec3.h"
+#include "error.h"
 #include "lens_internal.h"
+#include "polarization.h"
+#include "result.h"
 
 /* The lens's optics at one wavelength. */
 typedef struct lp__optics {
@@ -74,17 +77,59 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
                     const struct lp__branch *b, lp_vec3 p, const lp__payload *pl, int depth,
                     lp_kind kind, int surface, uint64_t path, lp_error *err);
 
-/* Check a bundle ray of lp_backward_gather and give its field direction
- * in the lens frame, perpendicular to the local light direction. */
-lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,
-                               lp_vec3 *vp, lp_error *err);
+
+/* The rays of field E (power `power`) leaving at x, each with the wave
+ * bits `waves`: lp__emit_power and lp__emit_gathered in one pass. */
+static inline lp_status lp__emit_parts(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
+                                       double power, const lp__exit *x, const lp__payload *pl,
+                                       int depth, lp_kind kind, int surface, uint64_t path,
+                                       uint64_t waves, lp_error *err)
+{
+    lp__linear_part part[2];
+    int n = lp__field_split(E, power, x->d, part);
+
+    for (int k = 0; k < n; k++) {
+        lp_out_ray *o = lp__result_push(res);
+        if (!o)
+            return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
+        o->ray.origin = x->world_origin;
+        o->ray.dir = x->world_dir;
+        o->ray.lambda_nm = pl->lambda_nm;
+        o->ray.intensity = part[k].intensity;
+        o->ray.vp = lp__to_world_dir(lens, part[k].vp);
+        o->ray.kphi = pl->kphi;
+        o->ray.op = pl->op;
+        o->ray.phase = lp__wrap_phase(pl->phase + part[k].phase);
+        o->ray.ch = pl->ch;
+        o->depth = depth;
+        o->kind = kind;
+        o->surface = surface;
+        o->part = k;
+        o->path = path;
+        o->waves = waves;
+        res->out += part[k].intensity;
+    }
+    return LP_OK;
+}
 
 /* Emit a gathered field E (of a bundle ray of power `in`, of which
  * `absorbed` went into the glass) as the rays of query q, leaving the
- * lens at x; the rest of `in` is counted as truncated. */
-lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
-                            const lp__exit *x, const lp__payload *pl, const lp_query *q,
-                            double in, double absorbed, lp_error *err);
+ * lens at x; the rest of `in` is counted as truncated (inline: every
+ * gathered ray leaves by it). */
+static inline lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res,
+                                          const lp__cvec3 *E, const lp__exit *x,
+                                          const lp__payload *pl, const lp_query *q, double in,
+                                          double absorbed, lp_error *err)
+{
+    double before = res->out;
+    lp_status st = lp__emit_parts(lens, res, E, cv3_norm2(*E), x, pl, q->depth, q->kind,
+                                  q->surface, q->path, q->waves, err);
+    if (st != LP_OK)
+        return st;
+    res->absorbed_glass += absorbed;
+    res->truncated += in - (res->out - before) - absorbed;
+    return LP_OK;
+}
 
 /* The unit vector along the part of v perpendicular to the unit d; *ok
  * is 0.0 when there is none (v parallel to d, zero or not finite), else
@@ -107,6 +152,29 @@ static inline int lp__perp_unit(lp_vec3 v, lp_vec3 d, lp_vec3 *out)
         return 0;
     *out = u;
     return 1;
+}
+
+/* Report in err what is wrong with a bundle ray that fails
+ * lp__bundle_ray_check (LP_ERROR_INVALID_ARGUMENT): its intensity, op or
+ * phase (what 0), or its polarization (what 1). */
+void lp__bundle_ray_fail(int what, lp_error *err);
+
+/* Check a bundle ray of lp_backward_gather and give its field direction
+ * in the lens frame, perpendicular to the local light direction (inline:
+ * every gathered ray is checked). */
+static inline lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b,
+                                             lp_vec3 light, lp_vec3 *vp, lp_error *err)
+{
+    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
+        !isfinite(b->phase)) {
+        lp__bundle_ray_fail(0, err);
+        return LP_ERROR_INVALID_ARGUMENT;
+    }
+    if (!v3_finite(b->vp) || !lp__perp_unit(lp__to_local_dir(lens, b->vp), light, vp)) {
+        lp__bundle_ray_fail(1, err);
+        return LP_ERROR_INVALID_ARGUMENT;
+    }
+    return LP_OK;
 }
 
 /* Check a forward input ray: its unit direction *d and the unit field

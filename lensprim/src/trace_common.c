@@ -96,45 +96,11 @@ lp__exit lp__exit_at(const lp_lens *lens, lp_vec3 p, lp_vec3 d)
     return x;
 }
 
-/* The rays of field E (power `power`) leaving at x, each with the wave
- * bits `waves`: lp__emit_power and lp__emit_gathered in one pass. */
-static inline lp_status emit_parts(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
-                                   double power, const lp__exit *x, const lp__payload *pl,
-                                   int depth, lp_kind kind, int surface, uint64_t path,
-                                   uint64_t waves, lp_error *err)
-{
-    lp__linear_part part[2];
-    int n = lp__field_split(E, power, x->d, part);
-
-    for (int k = 0; k < n; k++) {
-        lp_out_ray *o = lp__result_push(res);
-        if (!o)
-            return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
-        o->ray.origin = x->world_origin;
-        o->ray.dir = x->world_dir;
-        o->ray.lambda_nm = pl->lambda_nm;
-        o->ray.intensity = part[k].intensity;
-        o->ray.vp = lp__to_world_dir(lens, part[k].vp);
-        o->ray.kphi = pl->kphi;
-        o->ray.op = pl->op;
-        o->ray.phase = lp__wrap_phase(pl->phase + part[k].phase);
-        o->ray.ch = pl->ch;
-        o->depth = depth;
-        o->kind = kind;
-        o->surface = surface;
-        o->part = k;
-        o->path = path;
-        o->waves = waves;
-        res->out += part[k].intensity;
-    }
-    return LP_OK;
-}
-
 lp_status lp__emit_power(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, double power,
                          const lp__exit *x, const lp__payload *pl, int depth, lp_kind kind,
                          int surface, uint64_t path, lp_error *err)
 {
-    return emit_parts(lens, res, E, power, x, pl, depth, kind, surface, path, 0, err);
+    return lp__emit_parts(lens, res, E, power, x, pl, depth, kind, surface, path, 0, err);
 }
 
 lp_status lp__emit(const lp_lens *lens, lp_result *res, const lp__cvec3 *E, const lp__exit *x,
@@ -166,29 +132,12 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
     return lp__emit_power(lens, res, &b->E, power, &x, pl, depth, kind, surface, path, err);
 }
 
-lp_status lp__bundle_ray_check(const lp_lens *lens, const lp_ray *b, lp_vec3 light,
-                               lp_vec3 *vp, lp_error *err)
+void lp__bundle_ray_fail(int what, lp_error *err)
 {
-    if (!isfinite(b->intensity) || b->intensity < 0.0 || !isfinite(b->op) ||
-        !isfinite(b->phase))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray intensity, op and phase must be finite (intensity >= 0)");
-    if (!v3_finite(b->vp) || !lp__perp_unit(lp__to_local_dir(lens, b->vp), light, vp))
-        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
-                        "bundle ray polarization must be finite and not parallel to the query ray");
-    return LP_OK;
-}
-
-lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
-                            const lp__exit *x, const lp__payload *pl, const lp_query *q,
-                            double in, double absorbed, lp_error *err)
-{
-    double before = res->out;
-    lp_status st = emit_parts(lens, res, E, cv3_norm2(*E), x, pl, q->depth, q->kind, q->surface,
-                              q->path, q->waves, err);
-    if (st != LP_OK)
-        return st;
-    res->absorbed_glass += absorbed;
-    res->truncated += in - (res->out - before) - absorbed;
-    return LP_OK;
+    if (what == 0)
+        lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                 "bundle ray intensity, op and phase must be finite (intensity >= 0)");
+    else
+        lp__fail(err, LP_ERROR_INVALID_ARGUMENT,
+                 "bundle ray polarization must be finite and not parallel to the query ray");
 }
