@@ -49,7 +49,6 @@ typedef struct lp__lane_lens {
     double c[2], z0[2], hh[2], out[2]; /* caps; hh = h^2 (1 + 1e-12) */
     lp__rim r;
     double has_rim; /* 1: r.present, as a number */
-    double slack;   /* the rim's end tolerance (lp__rim_intersect's) */
     double eps;     /* lens->eps */
     double tol;     /* lp__lens_surface_at's */
     lp_vec3 pos, u, v, w;
@@ -66,7 +65,6 @@ static inline void lp__lane_lens_of(lp__lane_lens *K, const lp_lens *lens)
     }
     K->r = lens->rim;
     K->has_rim = lens->rim.present ? 1.0 : 0.0;
-    K->slack = 1e-12 * (K->r.z_b - K->r.z_a + K->r.rho_a + K->r.rho_b);
     K->eps = lens->eps;
     K->tol = 8.0 * lens->eps;
     K->pos = lens->desc.position;
@@ -141,7 +139,7 @@ LP__INLINE int lp__lane_cap_self(double c, double z0, double hh, lp_vec3 p, lp_v
 LP__INLINE int lp__lane_rim_band(const lp__lane_lens *K, lp_vec3 p, lp_vec3 x)
 {
     double lo = p.z < x.z ? p.z : x.z, hi = p.z < x.z ? x.z : p.z;
-    return !(hi < K->r.z_a - K->slack) & !(lo > K->r.z_b + K->slack);
+    return !(hi < K->r.z_a - K->r.slack) & !(lo > K->r.z_b + K->r.slack);
 }
 
 /* lens.c's inside_rim */
