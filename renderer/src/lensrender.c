@@ -530,6 +530,72 @@ lr_status lr_render_region_work(const lr_renderer *r, int x0, int y0, int x1, in
     return LR_OK;
 }
 
+/* A list of pixels, laid out as a 1-pixel-high image of n columns that
+ * the tiles cut into runs. */
+typedef struct list_ctx {
+    const rs_integrator *it;
+    const int *xy;
+    float *rgb;
+} list_ctx;
+
+static void render_list_tile(void *user, void *worker, int x0, int y0, int x1, int y1)
+{
+    list_ctx *c = user;
+    (void)y0;
+    (void)y1;
+    for (int k = x0; k < x1; k++) {
+        rs_color col;
+        float *px = c->rgb + 3 * (size_t)k;
+        rs_integrator_pixel(c->it, worker, c->xy[2 * (size_t)k], c->xy[2 * (size_t)k + 1], &col);
+        px[0] = (float)col.r;
+        px[1] = (float)col.g;
+        px[2] = (float)col.b;
+    }
+}
+
+static void *list_worker_make(void *user)
+{
+    const list_ctx *c = user;
+    return rs_worker_create(c->it);
+}
+
+lr_status lr_render_pixels(const lr_renderer *r, const int *xy, size_t n, float *rgb,
+                           lr_progress_fn progress, void *user, lr_error *err)
+{
+    list_ctx ctx;
+    int rc;
+    if (!r || (n > 0 && (!xy || !rgb)))
+        return fail(err, LR_ERROR_INVALID_ARGUMENT, "%s%s", "NULL renderer, list or buffer",
+                    NULL);
+    if (n > (size_t)LR_PIXELS_MAX)
+        return fail(err, LR_ERROR_INVALID_ARGUMENT, "%s%s",
+                    "more pixels in the list than an image has at most", NULL);
+    for (size_t k = 0; k < n; k++)
+        if (xy[2 * k] < 0 || xy[2 * k] >= r->settings.width || xy[2 * k + 1] < 0 ||
+            xy[2 * k + 1] >= r->settings.height)
+            return fail(err, LR_ERROR_INVALID_ARGUMENT, "%s%s",
+                        "a pixel of the list is outside the image", NULL);
+    if (n == 0) {
+        if (err)
+            memset(err, 0, sizeof *err);
+        return LR_OK;
+    }
+    ctx.it = r->it;
+    ctx.xy = xy;
+    ctx.rgb = rgb;
+    /* the list as one row of n <= LR_PIXELS_MAX columns */
+    rc = rs_render_tiles_cb((int)n, 1, TILE_SIZE, r->settings.threads, list_worker_make,
+                            worker_free, render_list_tile, &ctx, progress, user);
+    if (rc == -2)
+        return fail(err, LR_CANCELLED, "%s%s", "the render was cancelled", NULL);
+    if (rc != 0)
+        return fail(err, LR_ERROR_RENDER, "%s%s",
+                    "the render failed (out of memory for a worker thread)", NULL);
+    if (err)
+        memset(err, 0, sizeof *err);
+    return LR_OK;
+}
+
 lr_status lr_render_region(const lr_renderer *r, int x0, int y0, int x1, int y1, float *rgb,
                            lr_progress_fn progress, void *user, lr_error *err)
 {

@@ -27,6 +27,7 @@
 #include "sa_chart.h"
 #include "sa_error.h"
 #include "sa_point.h"
+#include "sa_refine.h"
 #include "sa_run.h"
 
 #define EXIT_USAGE 2
@@ -39,6 +40,7 @@ static const char *const usage_text[] = {
 "                      [--max-wavelengths N] [--sweep-wavelengths N]\n"
 "                      [--reference-seconds S]\n"
 "                      [--point-seconds S] [--auto-seconds S] [--reuse-references]\n"
+"       speed_accuracy --redo-auto [--scene NAME]... [options as above]\n"
 "       speed_accuracy --chart-only [--docs DIR]\n"
 "       speed_accuracy --help\n"
 "\n"
@@ -66,6 +68,11 @@ static const char *const usage_text[] = {
 "                   CPU time is left out (default 300)\n"
 "  --reuse-references    keep references already in the work directory\n"
 "  --references-only     make the references and stop\n"
+"  --redo-auto      measure the --mode auto points again (of every scene, or\n"
+"                   of the --scene ones) against the references kept in the\n"
+"                   work directory, and keep every other row of the\n"
+"                   existing speed-accuracy.csv: after a change of auto's\n"
+"                   rule, without sweeping again\n"
 "\n"
 "REFERENCE: polarized; at 128 wavelengths the depth doubled from 16 (to 64)\n"
 "and the cut-off divided by 100 from 1e-10 (to 1e-14) while that changes\n"
@@ -85,6 +92,7 @@ static const char *const usage_text[] = {
 typedef struct opts {
     const char *bin, *scenes, *docs, *work;
     int width, height, runs, max_wavelengths, reuse, chart_only, references_only;
+    int redo_auto;         /* only the auto points; the other rows from the CSV */
     int sweep_wavelengths; /* the sweep's largest wavelength count */
     double reference_seconds; /* a reference doubling predicted slower is not run */
     double point_seconds;     /* a swept setting predicted slower is not run */
@@ -128,6 +136,10 @@ typedef struct sa_reference {
     double dn_max, dn_rmse, dd_max, dd_rmse, dc_max, dc_rmse, u;
     double s_per_wl; /* CPU seconds per wavelength at depth 16, cut-off 1e-6 */
     int dn_cheap;    /* the wavelength doubling was measured there */
+    int whole;       /* the wavelengths of the whole image (sa_refine went on
+                        from there; wavelengths is the most a pixel has) */
+    long refined;    /* pixel renders of sa_refine (0: none) */
+    long left;       /* pixels still changing by more than REF_TOL */
 } sa_reference;
 
 typedef struct scene_ctx {
@@ -294,10 +306,11 @@ static int save_reference(scene_ctx *sc)
     f = fopen(path, "w");
     if (!f)
         return -1;
-    fprintf(f, "%d %d %d %d %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %d\n", sc->o->width,
-            sc->o->height, sc->rn.wavelengths, sc->rn.depth, sc->rn.cutoff, sc->rn.dn_max,
-            sc->rn.dn_rmse, sc->rn.dd_max, sc->rn.dd_rmse, sc->rn.dc_max, sc->rn.dc_rmse,
-            sc->rn.u, sc->rn.s_per_wl, sc->rn.dn_cheap);
+    fprintf(f, "%d %d %d %d %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %d %d %ld %ld\n",
+            sc->o->width, sc->o->height, sc->rn.wavelengths, sc->rn.depth, sc->rn.cutoff,
+            sc->rn.dn_max, sc->rn.dn_rmse, sc->rn.dd_max, sc->rn.dd_rmse, sc->rn.dc_max,
+            sc->rn.dc_rmse, sc->rn.u, sc->rn.s_per_wl, sc->rn.dn_cheap, sc->rn.whole,
+            sc->rn.refined, sc->rn.left);
     return fclose(f) == 0 ? 0 : -1;
 }
 
@@ -310,11 +323,14 @@ static int load_reference(scene_ctx *sc)
     f = fopen(path, "r");
     if (!f)
         return -1;
-    sc->rn.dn_cheap = 0; /* the last field is new: 13 fields mean 0 */
-    int ok = fscanf(f, "%d %d %d %d %lg %lg %lg %lg %lg %lg %lg %lg %lg %d", &w, &h,
+    /* the last fields are newer: missing, they are 0 */
+    sc->rn.dn_cheap = sc->rn.whole = 0;
+    sc->rn.refined = sc->rn.left = 0;
+    int ok = fscanf(f, "%d %d %d %d %lg %lg %lg %lg %lg %lg %lg %lg %lg %d %d %ld %ld", &w, &h,
                     &sc->rn.wavelengths, &sc->rn.depth, &sc->rn.cutoff, &sc->rn.dn_max,
                     &sc->rn.dn_rmse, &sc->rn.dd_max, &sc->rn.dd_rmse, &sc->rn.dc_max,
-                    &sc->rn.dc_rmse, &sc->rn.u, &sc->rn.s_per_wl, &sc->rn.dn_cheap) >= 13;
+                    &sc->rn.dc_rmse, &sc->rn.u, &sc->rn.s_per_wl, &sc->rn.dn_cheap,
+                    &sc->rn.whole, &sc->rn.refined, &sc->rn.left) >= 13;
     fclose(f);
     if (!ok || w != sc->o->width || h != sc->o->height)
         return -1;
@@ -341,17 +357,99 @@ static int ref_step(scene_ctx *sc, int n, int d, double c, rs_image *base, doubl
     return 0;
 }
 
+/* *dst = a copy of src; 0, or -1 out of memory. */
+static int image_copy(rs_image *dst, const rs_image *src)
+{
+    rs_image_free(dst);
+    if (rs_image_create(dst, src->width, src->height) != 0)
+        return -1;
+    memcpy(dst->rgb, src->rgb, 3 * sizeof(float) * (size_t)src->width * (size_t)src->height);
+    return 0;
+}
+
+/* *out = a - b, pixel by pixel; 0, or -1. */
+static int image_diff(rs_image *out, const rs_image *a, const rs_image *b)
+{
+    if (!a->rgb || !b->rgb || a->width != b->width || a->height != b->height ||
+        image_copy(out, a) != 0)
+        return -1;
+    for (size_t k = 0; k < 3 * (size_t)a->width * (size_t)a->height; k++)
+        out->rgb[k] -= b->rgb[k];
+    return 0;
+}
+
+/* Past the whole image's doublings: the pixels still changing, pixel by
+ * pixel (sa_refine.h), from `last`, each pixel's change in the last
+ * doubling measured. */
+static int refine_reference(scene_ctx *sc, int n, int d, double c, double seconds,
+                            rs_image *last)
+{
+    sa_refine_opts ro;
+    sa_refine_stats st;
+    char msg[512];
+    double pixels = (double)sc->o->width * sc->o->height;
+    ro.scene = sc->path;
+    ro.depth = d;
+    ro.cutoff = c;
+    ro.wavelengths = n;
+    ro.wavelengths_max = sc->o->max_wavelengths;
+    ro.tol = REF_TOL;
+    ro.budget = sc->o->reference_seconds;
+    ro.s_per_pixel_wl = seconds / (pixels * n);
+    if (sa_refine(&ro, &sc->ref, last, &st, msg, sizeof msg) != 0) {
+        say("%s: %s", sc->name, msg);
+        return -1;
+    }
+    fprintf(stderr,
+            "speed_accuracy: %s: pixel by pixel from %d wavelengths: %d doublings, %ld pixel "
+            "renders (%.3g s), up to %d wavelengths; last changes max %.3g, rmse %.3g; %ld "
+            "pixels over %g\n",
+            sc->name, n, st.levels, st.renders, st.seconds, st.wavelengths, st.max, st.rmse,
+            st.left, REF_TOL);
+    sc->rn.wavelengths = st.wavelengths;
+    sc->rn.refined = st.renders;
+    sc->rn.left = st.left;
+    sc->rn.dn_max = st.max;
+    sc->rn.dn_rmse = st.rmse;
+    return 0;
+}
+
 static int make_reference(scene_ctx *sc)
 {
     sa_point p;
-    rs_image base;
+    rs_image base, prev = {0, 0, NULL}, last = {0, 0, NULL};
     int n = REF_WAVELENGTHS0, d = REF_DEPTH0;
     double c = REF_CUTOFF0, seconds;
 
     if (sc->o->reuse && load_reference(sc) == 0) {
         fprintf(stderr, "speed_accuracy: %s: reference reused (%d wavelengths, depth %d)\n",
                 sc->name, sc->rn.wavelengths, sc->rn.depth);
+        if (!sc->o->redo_auto && sc->rn.refined == 0 && !(sc->rn.dn_max <= REF_TOL) &&
+            sc->rn.wavelengths >= 2 && 2 * sc->rn.wavelengths <= sc->o->max_wavelengths) {
+            /* made before the pixel by pixel doublings: each pixel's last
+             * change from a render at half its wavelengths, then on */
+            rs_image half = {0, 0, NULL}, last = {0, 0, NULL};
+            int rc;
+            sc->rn.whole = sc->rn.wavelengths;
+            sa_point_init(&p, "reference", "polarized", sc->rn.wavelengths / 2, sc->rn.depth,
+                          sc->rn.cutoff);
+            rc = render(sc, &p, 1, 0.0, &half) != 0 || image_diff(&last, &sc->ref, &half) != 0
+                     ? -1
+                     : refine_reference(sc, sc->rn.wavelengths, sc->rn.depth, sc->rn.cutoff,
+                                        2.0 * p.seconds, &last);
+            rs_image_free(&half);
+            rs_image_free(&last);
+            if (rc != 0)
+                return -1;
+            sc->rn.u = sc->rn.dn_rmse + sc->rn.dd_rmse + sc->rn.dc_rmse;
+        }
         return 0;
+    }
+    if (sc->o->redo_auto) {
+        /* the kept rows were measured against the kept reference */
+        say("%s: no reference of this size in the work directory: run the whole sweep%s",
+            sc->name, "");
+        return -1;
     }
     if (2 * n > sc->o->max_wavelengths) /* room for one doubling */
         n = sc->o->max_wavelengths > 1 ? sc->o->max_wavelengths / 2 : 1;
@@ -395,8 +493,14 @@ static int make_reference(scene_ctx *sc)
              * gives its wavelength error instead (the quadrature's error
              * is the main paths'; the deep, faint branches the reference
              * adds change no pixel's topology). */
-            if (ref_step(sc, 2 * n, CHEAP_DEPTH, CHEAP_CUTOFF, &cheap, &dmax, &drmse, &cheap_s) != 0)
+            if (image_copy(&prev, &cheap) != 0 ||
+                ref_step(sc, 2 * n, CHEAP_DEPTH, CHEAP_CUTOFF, &cheap, &dmax, &drmse, &cheap_s) != 0)
                 return -1;
+            /* each pixel's change, there: where the pixel by pixel
+             * doublings start */
+            if (image_diff(&last, &cheap, &prev) != 0)
+                return -1;
+            rs_image_free(&prev);
             sc->rn.dn_max = dmax;
             sc->rn.dn_rmse = drmse;
             sc->rn.dn_cheap = 1;
@@ -409,7 +513,8 @@ static int make_reference(scene_ctx *sc)
     }
     while (!sc->rn.dn_cheap && 2 * n <= sc->o->max_wavelengths &&
            2.5 * seconds <= sc->o->reference_seconds) {
-        if (ref_step(sc, 2 * n, d, c, &base, &sc->rn.dn_max, &sc->rn.dn_rmse, &seconds) != 0)
+        if (image_copy(&prev, &base) != 0 ||
+            ref_step(sc, 2 * n, d, c, &base, &sc->rn.dn_max, &sc->rn.dn_rmse, &seconds) != 0)
             return -1;
         fprintf(stderr,
                 "speed_accuracy: %s: wavelengths %d -> %d: max change %.3g, rmse %.3g (%.3g s)\n",
@@ -420,8 +525,19 @@ static int make_reference(scene_ctx *sc)
     }
     sc->ref = base;
     sc->rn.wavelengths = n;
+    sc->rn.whole = n;
     sc->rn.depth = d;
     sc->rn.cutoff = c;
+    sc->rn.refined = sc->rn.left = 0;
+    if (!sc->rn.dn_cheap && prev.rgb && image_diff(&last, &base, &prev) != 0)
+        return -1;
+    rs_image_free(&prev);
+    if (sc->rn.dn_max > REF_TOL && last.rgb && 2 * n <= sc->o->max_wavelengths &&
+        refine_reference(sc, n, d, c, seconds, &last) != 0) {
+        rs_image_free(&last);
+        return -1;
+    }
+    rs_image_free(&last);
     sc->rn.u = sc->rn.dn_rmse + sc->rn.dd_rmse + sc->rn.dc_rmse;
     return 0; /* saved by the process that gathers (reference_done) */
 }
@@ -532,6 +648,7 @@ typedef struct sweep {
     job_point *pts;
     long n_pts, cap;
     long mismatch; /* rank 0: the first point that came back as another, or -1 */
+    const sa_points *old; /* rank 0, --redo-auto: the existing table */
 } sweep;
 
 /* What an item's result starts with; the image's floats follow. */
@@ -564,7 +681,7 @@ static int list_points(sweep *w, int k)
 {
     sa_point p;
     sa_point_init(&p, "povray", "povray", 0, 0, 0.0);
-    if (add_point(w, k, &p) != 0)
+    if (!w->o->redo_auto && add_point(w, k, &p) != 0)
         return -1;
     for (size_t t = 0; t < N_OF(TOLERANCES); t++) {
         sa_point_init(&p, "auto", "auto", 0, 0, -1.0);
@@ -572,6 +689,8 @@ static int list_points(sweep *w, int k)
         if (add_point(w, k, &p) != 0)
             return -1;
     }
+    if (w->o->redo_auto)
+        return 0;
     for (size_t m = 0; m < N_OF(MODELS); m++)
         for (size_t wl = 0; wl < N_OF(WAVELENGTHS); wl++)
             for (size_t d = 0; d < N_OF(DEPTHS); d++)
@@ -739,13 +858,19 @@ static int write_table(const sweep *w, FILE *csv, sa_points *all)
     for (int s = 0; s < w->n_sc; s++) {
         const scene_ctx *sc = &w->sc[s];
         sa_point p;
+        char refined[160] = "last doubling of the wavelengths";
+        if (sc->rn.refined > 0)
+            snprintf(refined, sizeof refined,
+                     "%d wavelengths then pixel by pixel (%ld pixel renders; %ld pixels still "
+                     "over 1e-5); each pixel's last doubling",
+                     sc->rn.whole, sc->rn.refined, sc->rn.left);
         sa_point_init(&p, "reference", "polarized", sc->rn.wavelengths, sc->rn.depth,
                       sc->rn.cutoff);
         snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
         snprintf(p.note, sizeof p.note,
-                 "%d x %d pixels; last doubling of the wavelengths%s: max %.2g rmse %.2g; of "
+                 "%d x %d pixels; %s%s: max %.2g rmse %.2g; of "
                  "the depth: max %.2g rmse %.2g; cut-off / 100: max %.2g rmse %.2g",
-                 w->o->width, w->o->height,
+                 w->o->width, w->o->height, refined,
                  sc->rn.dn_cheap ? " (at depth 16 and cut-off 1e-6)" : "", sc->rn.dn_max, sc->rn.dn_rmse, sc->rn.dd_max, sc->rn.dd_rmse,
                  sc->rn.dc_max, sc->rn.dc_rmse);
         /* A reference's error columns: its own uncertainty (rmse: rn.u;
@@ -761,6 +886,84 @@ static int write_table(const sweep *w, FILE *csv, sa_points *all)
                 (sa_points_add(all, &w->pts[k].p) != 0 ||
                  sa_point_write_csv(csv, &w->pts[k].p) != 0))
                 return -1;
+    }
+    return 0;
+}
+
+static int put_row(sa_points *all, FILE *csv, const sa_point *p)
+{
+    return sa_points_add(all, p) != 0 || sa_point_write_csv(csv, p) != 0 ? -1 : 0;
+}
+
+static int scene_index(const sweep *w, const char *name)
+{
+    for (int s = 0; s < w->n_sc; s++)
+        if (strcmp(w->sc[s].name, name) == 0)
+            return s;
+    return -1;
+}
+
+/* Has the table an auto row of this scene and tolerance? */
+static int old_has_auto(const sa_points *old, const sa_point *p)
+{
+    for (size_t i = 0; i < old->n; i++)
+        if (strcmp(old->p[i].kind, "auto") == 0 && strcmp(old->p[i].scene, p->scene) == 0 &&
+            old->p[i].tolerance == p->tolerance)
+            return 1;
+    return 0;
+}
+
+/* Rank 0, --redo-auto: the existing table's rows in their order, each
+ * auto row of a scene run again replaced by its new measurement (left out
+ * where that could not run), and a new auto point without a row of its
+ * own after its scene's last row. */
+static int write_table_redo(const sweep *w, FILE *csv, sa_points *all)
+{
+    const sa_points *old = w->old;
+    for (size_t i = 0; i < old->n; i++) {
+        const sa_point *q = &old->p[i];
+        int s = scene_index(w, q->scene);
+        if (s < 0 || strcmp(q->kind, "auto") != 0) {
+            if (put_row(all, csv, q) != 0)
+                return -1;
+        } else {
+            for (long k = 0; k < w->n_pts; k++)
+                if (w->pts[k].scene == s && w->pts[k].measured &&
+                    w->pts[k].p.tolerance == q->tolerance && put_row(all, csv, &w->pts[k].p) != 0)
+                    return -1;
+        }
+        if (s >= 0 && (i + 1 == old->n || strcmp(old->p[i + 1].scene, q->scene) != 0))
+            for (long k = 0; k < w->n_pts; k++)
+                if (w->pts[k].scene == s && w->pts[k].measured && !old_has_auto(old, &w->pts[k].p) &&
+                    put_row(all, csv, &w->pts[k].p) != 0)
+                    return -1;
+    }
+    return 0;
+}
+
+/* Does the existing table hold every scene to run, at this size?  0, or
+ * -1 after saying why. */
+static int redo_check(const sweep *w)
+{
+    char size[64];
+    snprintf(size, sizeof size, "%d x %d pixels", w->o->width, w->o->height);
+    for (int s = 0; s < w->n_sc; s++) {
+        int found = 0;
+        for (size_t i = 0; i < w->old->n && !found; i++) {
+            const sa_point *q = &w->old->p[i];
+            if (strcmp(q->scene, w->sc[s].name) != 0 || strcmp(q->kind, "reference") != 0)
+                continue;
+            found = 1;
+            if (strncmp(q->note, size, strlen(size)) != 0) {
+                say("%s: the table's rows are not of %s: give the --width and --height of its run",
+                    w->sc[s].name, size);
+                return -1;
+            }
+        }
+        if (!found) {
+            say("%s: not in the existing table: run the whole sweep%s", w->sc[s].name, "");
+            return -1;
+        }
     }
     return 0;
 }
@@ -820,7 +1023,8 @@ static int run_sweep(mw_group *g, sweep *w, FILE *csv, sa_points *all)
             say("%s%s", msg, "");
         return 1;
     }
-    if (w->o->rank == 0 && !w->o->references_only && write_table(w, csv, all) != 0) {
+    if (w->o->rank == 0 && !w->o->references_only &&
+        (w->o->redo_auto ? write_table_redo(w, csv, all) : write_table(w, csv, all)) != 0) {
         say("cannot write the table%s%s", "", "");
         return 1;
     }
@@ -864,6 +1068,9 @@ static int parse(opts *o, int argc, char **argv)
             o->reuse = 1;
         } else if (strcmp(a, "--references-only") == 0) {
             o->references_only = 1;
+        } else if (strcmp(a, "--redo-auto") == 0) {
+            o->redo_auto = 1;
+            o->reuse = 1;
         } else if (strcmp(a, "--chart-only") == 0) {
             o->chart_only = 1;
         } else if (!v) {
@@ -931,7 +1138,7 @@ static int cmp_str(const void *a, const void *b)
 int main(int argc, char **argv)
 {
     opts o;
-    sa_points all;
+    sa_points all, old;
     char csv_path[PATH_BUF], msg[512];
     mw_group *g;
     int rc = 0;
@@ -944,6 +1151,7 @@ int main(int argc, char **argv)
     }
     o.rank = mw_group_rank(g);
     sa_points_init(&all);
+    sa_points_init(&old);
     snprintf(csv_path, sizeof csv_path, "%.4000s/speed-accuracy.csv", o.docs);
     if (o.rank == 0 && make_dir(o.docs) != 0) {
         say("%s: cannot create: %s", o.docs, strerror(errno));
@@ -993,6 +1201,15 @@ int main(int argc, char **argv)
             }
             w.n_sc++;
         }
+        if (o.rank == 0 && rc == 0 && o.redo_auto) {
+            if (sa_points_read_csv(csv_path, &old, msg, sizeof msg) != 0) {
+                say("%s: %s", csv_path, msg);
+                rc = 1;
+            } else {
+                w.old = &old;
+                rc = redo_check(&w) != 0;
+            }
+        }
         if (o.rank == 0 && rc == 0) {
             snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
             csv = fopen(tmp, "w");
@@ -1024,6 +1241,7 @@ int main(int argc, char **argv)
         rc = 1;
     }
     sa_points_free(&all);
+    sa_points_free(&old);
     rc = mw_agree(g, rc, NULL, msg, sizeof msg) != 0 ? 1 : 0;
     mw_group_end(g);
     return rc;

@@ -237,10 +237,41 @@ int main(void)
                   "%d x %d regions on %d threads give the image byte for byte", splits[s][0],
                   splits[s][1], threads);
         }
+        {
+            /* every pixel as a list, scrambled and with repeats: each value
+             * the whole image's */
+            static int xy[2 * (W * H + 5)];
+            static float got[3 * (W * H + 5)];
+            size_t n = 0;
+            for (int k = 0; k < W * H; k++, n++) {
+                int m = (int)(((long)k * 29 + 11) % (W * H)); /* 29 is prime to W * H */
+                xy[2 * n] = m % W;
+                xy[2 * n + 1] = m / W;
+            }
+            for (int k = 0; k < 5; k++, n++) {
+                xy[2 * n] = xy[2 * k];
+                xy[2 * n + 1] = xy[2 * k + 1];
+            }
+            int same = lr_render_pixels(rt, xy, n, got, NULL, NULL, &err) == LR_OK;
+            for (size_t k = 0; same && k < n; k++)
+                same = memcmp(&got[3 * k], &ref[3 * ((size_t)xy[2 * k + 1] * W + xy[2 * k])],
+                              3 * sizeof(float)) == 0;
+            CHECK(same, "a scrambled list of every pixel (and 5 again) on %d threads gives each "
+                  "pixel byte for byte", threads);
+        }
         lr_renderer_free(rt);
     }
     {
         float one[3];
+        int outside[4] = {1, 1, 2, H};
+        progress_log pl2 = {0, 1, 0, 0, 0};
+        CHECK(lr_render_pixels(r, outside, 2, img, NULL, NULL, &err) == LR_ERROR_INVALID_ARGUMENT,
+              "a list with a pixel outside the image is refused");
+        CHECK(lr_render_pixels(r, NULL, 0, NULL, NULL, NULL, &err) == LR_OK,
+              "an empty list renders nothing");
+        CHECK(lr_render_pixels(r, outside, 1, one, on_progress, &pl2, &err) == LR_OK &&
+                  pl2.last_done == 1 && pl2.last_total == 1,
+              "a list's progress counts its pixels (%lld of %lld)", pl2.last_done, pl2.last_total);
         CHECK(lr_render_region(r, W, 0, W + 1, 1, one, NULL, NULL, &err) ==
                   LR_ERROR_INVALID_ARGUMENT,
               "a region outside the image is refused");

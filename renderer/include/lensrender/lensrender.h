@@ -294,6 +294,19 @@ lr_status lr_render_image(const lr_renderer *renderer, float *rgb, lr_progress_f
 lr_status lr_render_region(const lr_renderer *renderer, int x0, int y0, int x1, int y1,
                            float *rgb, lr_progress_fn progress, void *user, lr_error *err);
 
+/* (Revision 2) Render a list of n pixels of the image, pixel k at
+ * (xy[2k], xy[2k + 1]) (0 <= x < width, 0 <= y < height; in any order,
+ * repeats allowed), into rgb[3k .. 3k + 2]: each value bit for bit what
+ * lr_render_image gives for that pixel.  For adaptive sampling, which
+ * goes back to a few scattered pixels at a time: the workers (whose
+ * buffers grow with the wavelengths) are made once for the list, not
+ * once per rectangle.  Threads, progress (counting the list's pixels)
+ * and returns as lr_render_image; n == 0 is allowed and renders nothing;
+ * a pixel outside the image is LR_ERROR_INVALID_ARGUMENT, before any is
+ * rendered. */
+lr_status lr_render_pixels(const lr_renderer *renderer, const int *xy, size_t n, float *rgb,
+                           lr_progress_fn progress, void *user, lr_error *err);
+
 /* What a render did: counts that depend only on the scene, the options
  * and the pixels rendered (never on the machine, its load, the threads or
  * the order), each a whole number, and the price the automatic mode puts
