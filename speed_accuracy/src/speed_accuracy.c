@@ -56,7 +56,9 @@ static const char *const usage_text[] = {
 "                   render's)\n"
 "  --runs K         timed runs per setting; its time is their median\n"
 "                   (default 3; a setting slower than 1 s runs once)\n"
-"  --scene NAME     only this scene (repeatable; default every *.scene)\n"
+"  --scene NAME     only this scene (repeatable; default every *.scene);\n"
+"                   the other scenes' rows of an existing table of the same\n"
+"                   size are kept\n"
 "  --max-wavelengths N   the reference's wavelength cap, <= 16384 (default 16384)\n"
 "  --sweep-wavelengths N   the swept settings' largest wavelength count\n"
 "                   (default 512)\n"
@@ -852,10 +854,9 @@ static void point_done(void *user, long k, const void *result, size_t size)
 }
 
 /* Rank 0: the table, each scene's reference first, then its points. */
-static int write_table(const sweep *w, FILE *csv, sa_points *all)
+static int write_scene(const sweep *w, int s, FILE *csv, sa_points *all)
 {
-    long k = 0;
-    for (int s = 0; s < w->n_sc; s++) {
+    {
         const scene_ctx *sc = &w->sc[s];
         sa_point p;
         char refined[160] = "last doubling of the wavelengths";
@@ -881,12 +882,20 @@ static int write_table(const sweep *w, FILE *csv, sa_points *all)
         p.seconds = NAN;
         if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
             return -1;
-        for (; k < w->n_pts && w->pts[k].scene == s; k++)
-            if (w->pts[k].measured &&
+        for (long k = 0; k < w->n_pts; k++)
+            if (w->pts[k].scene == s && w->pts[k].measured &&
                 (sa_points_add(all, &w->pts[k].p) != 0 ||
                  sa_point_write_csv(csv, &w->pts[k].p) != 0))
                 return -1;
     }
+    return 0;
+}
+
+static int write_table(const sweep *w, FILE *csv, sa_points *all)
+{
+    for (int s = 0; s < w->n_sc; s++)
+        if (write_scene(w, s, csv, all) != 0)
+            return -1;
     return 0;
 }
 
@@ -939,6 +948,45 @@ static int write_table_redo(const sweep *w, FILE *csv, sa_points *all)
                     return -1;
     }
     return 0;
+}
+
+/* Rank 0, --scene over an existing table of the same size: the table's
+ * rows in their order, each scene run again replaced by its new rows
+ * where its first row was (a scene new to the table at the end). */
+static int write_table_merge(const sweep *w, FILE *csv, sa_points *all)
+{
+    const sa_points *old = w->old;
+    unsigned char *done = calloc((size_t)w->n_sc + 1, 1);
+    int rc = done ? 0 : -1;
+    for (size_t i = 0; rc == 0 && i < old->n; i++) {
+        int s = scene_index(w, old->p[i].scene);
+        if (s < 0)
+            rc = put_row(all, csv, &old->p[i]);
+        else if (!done[s]) {
+            rc = write_scene(w, s, csv, all);
+            done[s] = 1;
+        }
+    }
+    for (int s = 0; rc == 0 && s < w->n_sc; s++)
+        if (!done[s])
+            rc = write_scene(w, s, csv, all);
+    free(done);
+    return rc;
+}
+
+/* Is every reference row of the table of this run's size? */
+static int old_size_ok(const sa_points *old, const opts *o)
+{
+    char size[64];
+    int any = 0;
+    snprintf(size, sizeof size, "%d x %d pixels", o->width, o->height);
+    for (size_t i = 0; i < old->n; i++)
+        if (strcmp(old->p[i].kind, "reference") == 0) {
+            if (strncmp(old->p[i].note, size, strlen(size)) != 0)
+                return 0;
+            any = 1;
+        }
+    return any;
 }
 
 /* Does the existing table hold every scene to run, at this size?  0, or
@@ -1024,7 +1072,9 @@ static int run_sweep(mw_group *g, sweep *w, FILE *csv, sa_points *all)
         return 1;
     }
     if (w->o->rank == 0 && !w->o->references_only &&
-        (w->o->redo_auto ? write_table_redo(w, csv, all) : write_table(w, csv, all)) != 0) {
+        (w->o->redo_auto ? write_table_redo(w, csv, all)
+         : w->old        ? write_table_merge(w, csv, all)
+                         : write_table(w, csv, all)) != 0) {
         say("cannot write the table%s%s", "", "");
         return 1;
     }
@@ -1209,6 +1259,14 @@ int main(int argc, char **argv)
                 w.old = &old;
                 rc = redo_check(&w) != 0;
             }
+        } else if (o.rank == 0 && rc == 0 && o.n_only > 0 && !o.references_only) {
+            /* some scenes: the others' rows of the table are kept */
+            if (sa_points_read_csv(csv_path, &old, msg, sizeof msg) == 0 &&
+                old_size_ok(&old, &o))
+                w.old = &old;
+            else if (old.n > 0)
+                say("%s: of another size or unreadable: it keeps only the scenes of this "
+                    "run%s", csv_path, "");
         }
         if (o.rank == 0 && rc == 0) {
             snprintf(tmp, sizeof tmp, "%s.tmp", csv_path);
