@@ -442,8 +442,10 @@ const char *lr_renderer_explanation(const lr_renderer *r)
 
 /* ---- rendering --------------------------------------------------------- */
 
+/* The tiles' contexts (region_ctx, list_ctx) start with the integrator,
+ * which is all worker_make reads. */
 typedef struct region_ctx {
-    const rs_integrator *it;
+    const rs_integrator *it; /* first: worker_make */
     float *rgb;
     int x0, y0, w; /* the region's corner in the image and its width */
     atomic_llong pixels, rays, lane_rays, builds, gathered; /* the tiles' work, summed */
@@ -451,8 +453,7 @@ typedef struct region_ctx {
 
 static void *worker_make(void *user)
 {
-    const region_ctx *c = user;
-    return rs_worker_create(c->it);
+    return rs_worker_create(*(const rs_integrator *const *)user);
 }
 
 static void worker_free(void *worker)
@@ -482,6 +483,19 @@ static void render_tile(void *user, void *worker, int x0, int y0, int x1, int y1
     atomic_fetch_add(&c->lane_rays, (long long)(after.lane_rays - before.lane_rays));
     atomic_fetch_add(&c->builds, (long long)(after.builds - before.builds));
     atomic_fetch_add(&c->gathered, (long long)(after.gathered - before.gathered));
+}
+
+/* lr_status of rs_render_tiles_cb's return (err cleared on success). */
+static lr_status tiles_status(int rc, lr_error *err)
+{
+    if (rc == -2)
+        return fail(err, LR_CANCELLED, "%s%s", "the render was cancelled", NULL);
+    if (rc != 0)
+        return fail(err, LR_ERROR_RENDER, "%s%s",
+                    "the render failed (out of memory for a worker thread)", NULL);
+    if (err)
+        memset(err, 0, sizeof *err);
+    return LR_OK;
 }
 
 lr_status lr_render_region_work(const lr_renderer *r, int x0, int y0, int x1, int y1,
@@ -520,20 +534,13 @@ lr_status lr_render_region_work(const lr_renderer *r, int x0, int y0, int x1, in
         work->gathered = d.gathered;
         work->cost = rs_work_cost(&d, to_rs_mode(r->settings.mode), work->pixels);
     }
-    if (rc == -2)
-        return fail(err, LR_CANCELLED, "%s%s", "the render was cancelled", NULL);
-    if (rc != 0)
-        return fail(err, LR_ERROR_RENDER, "%s%s",
-                    "the render failed (out of memory for a worker thread)", NULL);
-    if (err)
-        memset(err, 0, sizeof *err);
-    return LR_OK;
+    return tiles_status(rc, err);
 }
 
 /* A list of pixels, laid out as a 1-pixel-high image of n columns that
  * the tiles cut into runs. */
 typedef struct list_ctx {
-    const rs_integrator *it;
+    const rs_integrator *it; /* first, as in region_ctx (worker_make) */
     const int *xy;
     float *rgb;
 } list_ctx;
@@ -551,12 +558,6 @@ static void render_list_tile(void *user, void *worker, int x0, int y0, int x1, i
         px[1] = (float)col.g;
         px[2] = (float)col.b;
     }
-}
-
-static void *list_worker_make(void *user)
-{
-    const list_ctx *c = user;
-    return rs_worker_create(c->it);
 }
 
 lr_status lr_render_pixels(const lr_renderer *r, const int *xy, size_t n, float *rgb,
@@ -584,16 +585,9 @@ lr_status lr_render_pixels(const lr_renderer *r, const int *xy, size_t n, float 
     ctx.xy = xy;
     ctx.rgb = rgb;
     /* the list as one row of n <= LR_PIXELS_MAX columns */
-    rc = rs_render_tiles_cb((int)n, 1, TILE_SIZE, r->settings.threads, list_worker_make,
+    rc = rs_render_tiles_cb((int)n, 1, TILE_SIZE, r->settings.threads, worker_make,
                             worker_free, render_list_tile, &ctx, progress, user);
-    if (rc == -2)
-        return fail(err, LR_CANCELLED, "%s%s", "the render was cancelled", NULL);
-    if (rc != 0)
-        return fail(err, LR_ERROR_RENDER, "%s%s",
-                    "the render failed (out of memory for a worker thread)", NULL);
-    if (err)
-        memset(err, 0, sizeof *err);
-    return LR_OK;
+    return tiles_status(rc, err);
 }
 
 lr_status lr_render_region(const lr_renderer *r, int x0, int y0, int x1, int y1, float *rgb,

@@ -413,6 +413,7 @@ static int refine_reference(scene_ctx *sc, int n, int d, double c, double second
     sc->rn.left = st.left;
     sc->rn.dn_max = st.max;
     sc->rn.dn_rmse = st.rmse;
+    sc->rn.u = sc->rn.dn_rmse + sc->rn.dd_rmse + sc->rn.dc_rmse;
     return 0;
 }
 
@@ -443,7 +444,6 @@ static int make_reference(scene_ctx *sc)
             rs_image_free(&last);
             if (rc != 0)
                 return -1;
-            sc->rn.u = sc->rn.dn_rmse + sc->rn.dd_rmse + sc->rn.dc_rmse;
         }
         return 0;
     }
@@ -856,38 +856,36 @@ static void point_done(void *user, long k, const void *result, size_t size)
 /* Rank 0: the table, each scene's reference first, then its points. */
 static int write_scene(const sweep *w, int s, FILE *csv, sa_points *all)
 {
-    {
-        const scene_ctx *sc = &w->sc[s];
-        sa_point p;
-        char refined[160] = "last doubling of the wavelengths";
-        if (sc->rn.refined > 0)
-            snprintf(refined, sizeof refined,
-                     "%d wavelengths then pixel by pixel (%ld pixel renders; %ld pixels still "
-                     "over 1e-5); each pixel's last doubling",
-                     sc->rn.whole, sc->rn.refined, sc->rn.left);
-        sa_point_init(&p, "reference", "polarized", sc->rn.wavelengths, sc->rn.depth,
-                      sc->rn.cutoff);
-        snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
-        snprintf(p.note, sizeof p.note,
-                 "%d x %d pixels; %s%s: max %.2g rmse %.2g; of "
-                 "the depth: max %.2g rmse %.2g; cut-off / 100: max %.2g rmse %.2g",
-                 w->o->width, w->o->height, refined,
-                 sc->rn.dn_cheap ? " (at depth 16 and cut-off 1e-6)" : "", sc->rn.dn_max, sc->rn.dn_rmse, sc->rn.dd_max, sc->rn.dd_rmse,
-                 sc->rn.dc_max, sc->rn.dc_rmse);
-        /* A reference's error columns: its own uncertainty (rmse: rn.u;
-         * max_abs: the last wavelength doubling's largest change). */
-        p.err.rmse = sc->rn.u;
-        p.err.max_abs = sc->rn.dn_max;
-        p.err.share_visible = NAN;
-        p.seconds = NAN;
-        if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
+    const scene_ctx *sc = &w->sc[s];
+    sa_point p;
+    char refined[160] = "last doubling of the wavelengths";
+    if (sc->rn.refined > 0)
+        snprintf(refined, sizeof refined,
+                 "%d wavelengths then pixel by pixel (%ld pixel renders; %ld pixels still "
+                 "over 1e-5); each pixel's last doubling",
+                 sc->rn.whole, sc->rn.refined, sc->rn.left);
+    sa_point_init(&p, "reference", "polarized", sc->rn.wavelengths, sc->rn.depth,
+                  sc->rn.cutoff);
+    snprintf(p.scene, sizeof p.scene, "%.63s", sc->name);
+    snprintf(p.note, sizeof p.note,
+             "%d x %d pixels; %s%s: max %.2g rmse %.2g; of "
+             "the depth: max %.2g rmse %.2g; cut-off / 100: max %.2g rmse %.2g",
+             w->o->width, w->o->height, refined,
+             sc->rn.dn_cheap ? " (at depth 16 and cut-off 1e-6)" : "", sc->rn.dn_max, sc->rn.dn_rmse, sc->rn.dd_max, sc->rn.dd_rmse,
+             sc->rn.dc_max, sc->rn.dc_rmse);
+    /* A reference's error columns: its own uncertainty (rmse: rn.u;
+     * max_abs: the last wavelength doubling's largest change). */
+    p.err.rmse = sc->rn.u;
+    p.err.max_abs = sc->rn.dn_max;
+    p.err.share_visible = NAN;
+    p.seconds = NAN;
+    if (sa_points_add(all, &p) != 0 || sa_point_write_csv(csv, &p) != 0)
+        return -1;
+    for (long k = 0; k < w->n_pts; k++)
+        if (w->pts[k].scene == s && w->pts[k].measured &&
+            (sa_points_add(all, &w->pts[k].p) != 0 ||
+             sa_point_write_csv(csv, &w->pts[k].p) != 0))
             return -1;
-        for (long k = 0; k < w->n_pts; k++)
-            if (w->pts[k].scene == s && w->pts[k].measured &&
-                (sa_points_add(all, &w->pts[k].p) != 0 ||
-                 sa_point_write_csv(csv, &w->pts[k].p) != 0))
-                return -1;
-    }
     return 0;
 }
 
@@ -993,21 +991,18 @@ static int old_size_ok(const sa_points *old, const opts *o)
  * -1 after saying why. */
 static int redo_check(const sweep *w)
 {
-    char size[64];
-    snprintf(size, sizeof size, "%d x %d pixels", w->o->width, w->o->height);
+    if (!old_size_ok(w->old, w->o)) {
+        char size[64];
+        snprintf(size, sizeof size, "%d x %d pixels", w->o->width, w->o->height);
+        say("the table's rows are not of %s: give the --width and --height of its run%s", size,
+            "");
+        return -1;
+    }
     for (int s = 0; s < w->n_sc; s++) {
         int found = 0;
-        for (size_t i = 0; i < w->old->n && !found; i++) {
-            const sa_point *q = &w->old->p[i];
-            if (strcmp(q->scene, w->sc[s].name) != 0 || strcmp(q->kind, "reference") != 0)
-                continue;
-            found = 1;
-            if (strncmp(q->note, size, strlen(size)) != 0) {
-                say("%s: the table's rows are not of %s: give the --width and --height of its run",
-                    w->sc[s].name, size);
-                return -1;
-            }
-        }
+        for (size_t i = 0; i < w->old->n && !found; i++)
+            found = strcmp(w->old->p[i].scene, w->sc[s].name) == 0 &&
+                    strcmp(w->old->p[i].kind, "reference") == 0;
         if (!found) {
             say("%s: not in the existing table: run the whole sweep%s", w->sc[s].name, "");
             return -1;
