@@ -488,7 +488,7 @@ static choice choose(const probe_set *ps, double E, int pol_only, rs_mode L, con
                 if (pol_only && spectral[m] != RS_MODE_POLARIZED)
                     continue;
                 choice c = {spectral[m], rung_n[k], t, k, 0, e_wl, tr[t].e, e_model[spectral[m]], 0};
-                c.e = c.e_wl + c.e_tree + c.e_model;
+                c.e = hypot(c.e_wl, c.e_model) + c.e_tree;
                 c.cost = rung[k].cost * tcost * mcost[spectral[m]];
                 consider(&best, n_cand, E, c);
             }
@@ -499,7 +499,7 @@ static choice choose(const probe_set *ps, double E, int pol_only, rs_mode L, con
             if (!rgb[t].c)
                 continue;
             choice c = {RS_MODE_RGB, 0, t, -1, 0, 0, 0, 0, rgb[t].cost};
-            c.e = rms_diff(ps, rgb[t].c, top->c) + e_t + tr[t_lad].e + e_model[L];
+            c.e = hypot(rms_diff(ps, rgb[t].c, top->c) + e_t, e_model[L]) + tr[t_lad].e;
             c.e_model = c.e;
             consider(&best, n_cand, E, c);
         }
@@ -677,8 +677,8 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         if (best.mode == RS_MODE_RGB)
             snprintf(parts, sizeof parts, "measured against %d wavelengths", rung_n[n_rungs - 1]);
         else
-            snprintf(parts, sizeof parts, "wavelengths %.2g + tree %.2g + model %.2g", best.e_wl,
-                     best.e_tree, best.e_model);
+            snprintf(parts, sizeof parts, "wavelengths %.2g and model %.2g in quadrature, + tree %.2g",
+                     best.e_wl, best.e_model, best.e_tree);
         if (best.mode == RS_MODE_RGB)
             snprintf(why, why_size,
                      "rgb, depth %d, cut-off %.3g for E = %.3g: estimated error %.2g (%s), the "

@@ -26,11 +26,22 @@
  *               or below the floor) is the probe's reference for the
  *               tree, counted 0.1 E off.
  *
- * The estimate of a candidate (model m, N wavelengths, tree T) is a sum
- * of measured parts, each an RMS difference over the probe (the triangle
- * inequality: the parts of an error add at most linearly):
+ * The estimate of a candidate (model m, N wavelengths, tree T) is made of
+ * measured parts, each an RMS difference over the probe:
  *
- *   e = e_wl(N) + e_tree(T) + e_model(m)
+ *   e = sqrt(e_wl(N)^2 + e_model(m)^2) + e_tree(T)
+ *
+ * The wavelength and model parts add in quadrature: a too coarse
+ * wavelength grid errs in sign with the grid (its error changes sign
+ * from one count to the next), the unpolarized laws' error is the same
+ * at every count, and over an image the two are uncorrelated -- measured
+ * on the chart's references at 128 x 96, depth 16, cut-off 1e-3: fresnel
+ * at 64 wavelengths against the reference 9.3e-4, 9.6e-4, 9.7e-4
+ * (conical_rim, default, meniscus) where polarized at 64 is 7.3e-4,
+ * 7.9e-4, 7.8e-4 and fresnel at 512 (its model's error) 6.0e-4, 5.3e-4,
+ * 5.7e-4: in quadrature 9.4e-4, 9.5e-4, 9.7e-4; summed 1.3e-3 to 1.4e-3.
+ * The tree's part (light the dropped branches would have carried: it
+ * only darkens) adds linearly, the triangle inequality's bound.
  *
  *   e_wl(N)     the ladder: the probe rendered in the ladder's model
  *               (fresnel, or polarized where it is the only one) at the
@@ -49,8 +60,9 @@
  *               wavelengths where the scene needs it), plus 0.1 E.
  *   e_model(m)  m's difference from polarized at 4 wavelengths and the
  *               ladder's tree.
- *   rgb         (no wavelengths) its difference from the ladder's top,
- *               plus the top's own error, tree and model parts.
+ *   rgb         (no wavelengths) its difference from the ladder's top
+ *               plus the top's own error, in quadrature with the top's
+ *               model part, plus the top's tree part.
  *
  * Costs are deterministic: every probe render counts its work
  * (rs_worker_work) and prices it (rs_work_cost); a candidate's cost is
