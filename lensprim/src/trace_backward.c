@@ -378,9 +378,9 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp__bw_way *
         }
         pl.kphi += flip;
     }
-    if (real)
-        E = cv3_real(e, 1.0);
     res->nodes += (size_t)k;
+    if (real)
+        return lp__emit_gathered_real(bw->lens, res, e, &bw->exit, &pl, q, I0, absorbed, err);
     return lp__emit_gathered(bw->lens, res, &E, &bw->exit, &pl, q, I0, absorbed, err);
 }
 

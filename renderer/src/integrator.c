@@ -47,6 +47,7 @@
 #include "shapes.h"
 #include "emitter.h"
 #include "support/vec.h"
+#include "wide.h"
 
 #define RS_MAX_FRAMES 400
 #define RS_PI 3.14159265358979323846
@@ -1340,31 +1341,62 @@ static void emit_halves(void *ctx, int source, double radiance)
     }
 }
 
+/* Whether lane l emits in shared_halves: got[l] set (got NULL: v[l] != 0). */
+static inline int lane_emits(const double *v, const unsigned char *got, int l)
+{
+    return got ? got[l] != 0 : v[l] != 0.0;
+}
+
+/* The shared vector of the halves of a source for every lane 0..nl-1: a
+ * lane that emits (lane_emits) has the ray with intensity 0.5 v[l], the
+ * others have +0.  Every lane in one pass, the lanes kept by a bit mask
+ * (no branch: it vectorizes). */
+RS_WIDE static void halves_every_lane(int nl, const double *restrict v,
+                                      const unsigned char *restrict got, double *restrict I,
+                                      unsigned char *restrict has)
+{
+    for (int l = 0; l < nl; l++) {
+        unsigned char keep = got ? got[l] != 0 : v[l] != 0.0;
+        double x = 0.5 * v[l];
+        uint64_t bits;
+        memcpy(&bits, &x, sizeof bits);
+        bits &= (uint64_t)0 - keep;
+        has[l] = keep;
+        memcpy(&I[l], &bits, sizeof bits);
+    }
+}
+
 /* The pair of shared halves (emit_halves for several lanes at once) of
  * one source for the lanes lane[0..n) that emit there: those with
  * got[l] set (got NULL: those with v[l] != 0), l = lane[k], radiance
- * v[l]; none when no lane emits.  Returns -1 when out of memory. */
+ * v[l]; none when no lane emits.  The vector of a packet of every lane
+ * (n == nl: its lanes are 0..nl-1 in some order) is filled in a loop that
+ * vectorizes.  Returns -1 when out of memory. */
 static int shared_halves(int nl, const emit_ctx *e, int source, const int *lane, int n,
                          const double *v, const unsigned char *got)
 {
     bundle *out = e->out;
     double *I;
     unsigned char *has;
-    int k = 0;
-    while (k < n && !(got ? got[lane[k]] : v[lane[k]] != 0.0))
+    int every = n == nl, k = 0;
+    while (k < n && !lane_emits(v, got, lane[k]))
         k++;
     if (k == n)
         return 0;
-    lp_ray *r = bundle_push_shared(out, nl, 1, &I, &has);
+    lp_ray *r = bundle_push_shared(out, nl, !every, &I, &has);
     if (!r)
         return -1;
     half_ray(e, source, 0, r);
     r->intensity = 0.5 * v[lane[k]];
-    for (; k < n; k++) {
-        int l = lane[k];
-        if (got ? got[l] : v[l] != 0.0) {
-            has[l] = 1;
-            I[l] = 0.5 * v[l];
+    if (every) {
+        halves_every_lane(nl, v, got, I, has);
+    } else {
+        for (; k < n; k++) {
+            int l = lane[k];
+            if (lane_emits(v, got, l)) {
+                has[l] = 1;
+                I[l] = 0.5 * v[l];
+            }
         }
     }
     /* the other half: the same lanes and intensities, the same vector */
@@ -1557,9 +1589,10 @@ static int gather_groups(frame *fr, size_t j, int batch, size_t n_g)
  * quotient is exactly 1 in a lane whose input is I0 and the lane gets gI
  * itself.  Every lane in one pass, the lanes kept by a bit mask (no
  * branch: it vectorizes). */
-static void scale_lanes(int nl, const double *restrict cI, const unsigned char *restrict ch,
-                        const unsigned char *restrict bad, double I0, double gI,
-                        double *restrict Io, unsigned char *restrict has)
+RS_WIDE static void scale_lanes(int nl, const double *restrict cI,
+                                const unsigned char *restrict ch,
+                                const unsigned char *restrict bad, double I0, double gI,
+                                double *restrict Io, unsigned char *restrict has)
 {
     for (int k = 0; k < nl; k++) {
         double v = gI * (cI[k] / I0);
@@ -1790,7 +1823,7 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
 }
 
 /* L[k] += I[k] for every lane (vectorized). */
-static void add_lanes(int nl, const double *restrict I, double *restrict L)
+RS_WIDE static void add_lanes(int nl, const double *restrict I, double *restrict L)
 {
     for (int k = 0; k < nl; k++)
         L[k] += I[k];
