@@ -78,6 +78,36 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
                     lp_kind kind, int surface, uint64_t path, lp_error *err);
 
 
+/* Store the outgoing ray k (intensity, world field direction vp, phase
+ * relative to the payload's) of a field leaving at x, with the wave bits
+ * `waves`, and add its power to res->out. */
+static inline lp_status lp__emit_ray(lp_result *res, const lp__exit *x, const lp__payload *pl,
+                                     int depth, lp_kind kind, int surface, uint64_t path,
+                                     uint64_t waves, int k, double intensity, lp_vec3 vp,
+                                     double phase, lp_error *err)
+{
+    lp_out_ray *o = lp__result_push(res);
+    if (!o)
+        return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
+    o->ray.origin = x->world_origin;
+    o->ray.dir = x->world_dir;
+    o->ray.lambda_nm = pl->lambda_nm;
+    o->ray.intensity = intensity;
+    o->ray.vp = vp;
+    o->ray.kphi = pl->kphi;
+    o->ray.op = pl->op;
+    o->ray.phase = lp__wrap_phase(pl->phase + phase);
+    o->ray.ch = pl->ch;
+    o->depth = depth;
+    o->kind = kind;
+    o->surface = surface;
+    o->part = k;
+    o->path = path;
+    o->waves = waves;
+    res->out += intensity;
+    return LP_OK;
+}
+
 /* The linear parts part[0..n) of a field leaving at x as rays, each with
  * the wave bits `waves`. */
 static inline lp_status lp__emit_linear(const lp_lens *lens, lp_result *res,
@@ -87,25 +117,11 @@ static inline lp_status lp__emit_linear(const lp_lens *lens, lp_result *res,
                                         lp_error *err)
 {
     for (int k = 0; k < n; k++) {
-        lp_out_ray *o = lp__result_push(res);
-        if (!o)
-            return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
-        o->ray.origin = x->world_origin;
-        o->ray.dir = x->world_dir;
-        o->ray.lambda_nm = pl->lambda_nm;
-        o->ray.intensity = part[k].intensity;
-        o->ray.vp = lp__to_world_dir(lens, part[k].vp);
-        o->ray.kphi = pl->kphi;
-        o->ray.op = pl->op;
-        o->ray.phase = lp__wrap_phase(pl->phase + part[k].phase);
-        o->ray.ch = pl->ch;
-        o->depth = depth;
-        o->kind = kind;
-        o->surface = surface;
-        o->part = k;
-        o->path = path;
-        o->waves = waves;
-        res->out += part[k].intensity;
+        lp_status st = lp__emit_ray(res, x, pl, depth, kind, surface, path, waves, k,
+                                    part[k].intensity, lp__to_world_dir(lens, part[k].vp),
+                                    part[k].phase, err);
+        if (st != LP_OK)
+            return st;
     }
     return LP_OK;
 }
@@ -120,6 +136,15 @@ static inline lp_status lp__emit_parts(const lp_lens *lens, lp_result *res, cons
     lp__linear_part part[2];
     int n = lp__field_split(E, power, x->d, part);
     return lp__emit_linear(lens, res, part, n, x, pl, depth, kind, surface, path, waves, err);
+}
+
+/* The accounts of a gathered bundle ray of power `in` once its rays are
+ * stored (res->out was `before`): `absorbed` went into the glass, the rest
+ * not leaving is truncated. */
+static inline void lp__gathered_rest(lp_result *res, double before, double in, double absorbed)
+{
+    res->absorbed_glass += absorbed;
+    res->truncated += in - (res->out - before) - absorbed;
 }
 
 /* Emit the linear parts part[0..n) of a gathered field (of a bundle ray
@@ -137,8 +162,7 @@ static inline lp_status lp__emit_gathered_parts(const lp_lens *lens, lp_result *
                                    q->path, q->waves, err);
     if (st != LP_OK)
         return st;
-    res->absorbed_glass += absorbed;
-    res->truncated += in - (res->out - before) - absorbed;
+    lp__gathered_rest(res, before, in, absorbed);
     return LP_OK;
 }
 
