@@ -125,6 +125,7 @@ typedef struct colour_entry {
     rs_color c;
     unsigned gen; /* 0: unused */
     int n_valid;  /* lanes of this generation evaluated */
+    int dark;     /* 1: every lane is evaluated, and is 0 */
 } colour_entry;
 
 
@@ -564,7 +565,8 @@ static lp_ray *bundle_push(bundle *b, int lane)
  * caller sets every entry.  A shared vector's intensity is 0 in every
  * lane that does not have the ray, so that a lane's sum may add the whole
  * vector.  NULL when out of memory. */
-static lp_ray *bundle_push_shared(bundle *b, int nl, int clear, double **I, unsigned char **has)
+static inline lp_ray *bundle_push_shared(bundle *b, int nl, int clear, double **I,
+                                         unsigned char **has)
 {
     if (b->ns == b->scap) {
         size_t cap = b->scap ? 2 * b->scap : 8;
@@ -717,6 +719,7 @@ static const double *lane_colour_fill(rs_worker *w, int kind, size_t e, rs_color
     if (ce->gen == 0 || memcmp(&ce->c, &c, sizeof c) != 0) {
         ce->c = c;
         ce->n_valid = 0;
+        ce->dark = 0;
         if (++ce->gen == 0) { /* wrapped: no stamp may match a new generation */
             memset(stamp, 0, (size_t)it->n_lanes * sizeof *stamp);
             ce->gen = 1;
@@ -733,22 +736,39 @@ static const double *lane_colour_fill(rs_worker *w, int kind, size_t e, rs_color
         stamp[l] = ce->gen;
         ce->n_valid++;
     }
+    if (ce->n_valid == it->n_lanes) {
+        int dark = 1;
+        for (int l = 0; l < it->n_lanes; l++)
+            dark &= !(v[l] != 0.0);
+        ce->dark = dark;
+    }
     return v;
 }
 
 /* Colour c for use `kind` (see colour_entry) in lanes lane[0..n), at
  * [lane] of the array returned (the other lanes' values may be stale):
  * band_reflectance for the pigment and mirror colours, band_emission for
- * the others.  Valid until the next look-up of this kind.  Inline, the
- * look-up of a colour held in every lane already (the usual case). */
-static inline const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane,
-                                        int n)
+ * the others; its entry in *entry.  Valid until the next look-up of this
+ * kind.  Inline, the look-up of a colour held in every lane already (the
+ * usual case). */
+static inline const double *lane_colour_entry(rs_worker *w, int kind, rs_color c,
+                                              const int *lane, int n,
+                                              const colour_entry **entry)
 {
     size_t e = colour_slot(w, c);
     const colour_entry *ce = &w->cc[kind][e];
+    *entry = ce;
     if (ce->gen != 0 && ce->n_valid == w->it->n_lanes && memcmp(&ce->c, &c, sizeof c) == 0)
         return w->cc_val + ((size_t)kind * w->cc_n + e) * (size_t)w->it->n_lanes;
     return lane_colour_fill(w, kind, e, c, lane, n);
+}
+
+/* lane_colour_entry without the entry. */
+static inline const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane,
+                                        int n)
+{
+    const colour_entry *ce;
+    return lane_colour_entry(w, kind, c, lane, n, &ce);
 }
 
 /* The parity (0 or 1) of floor(v + 1e-10) for any v: below 2^62 the
@@ -952,6 +972,7 @@ typedef struct shade_point {
     /* per lane of the packet (lane_colour): valid until the worker shades
      * another point */
     const double *emission, *ambient, *pigment;
+    const colour_entry *emission_entry, *ambient_entry; /* their entries */
 } shade_point;
 
 static void shade_begin(rs_worker *w, const int *lane, int n, const rs_hit *h, lp_vec3 dir,
@@ -963,9 +984,11 @@ static void shade_begin(rs_worker *w, const int *lane, int n, const rs_hit *h, l
     const rs_finish *f = &o->finish;
     sp->h = h;
     sp->pig = pigment_at(&o->pigment, h->point);
-    sp->emission = lane_colour(w, CC_EMISSION, mul(sp->pig, f->emission), lane, n);
-    sp->ambient = lane_colour(w, CC_AMBIENT,
-                              mul(sp->pig, mul(f->ambient, sc->settings.ambient_light)), lane, n);
+    sp->emission = lane_colour_entry(w, CC_EMISSION, mul(sp->pig, f->emission), lane, n,
+                                     &sp->emission_entry);
+    sp->ambient = lane_colour_entry(w, CC_AMBIENT,
+                                    mul(sp->pig, mul(f->ambient, sc->settings.ambient_light)),
+                                    lane, n, &sp->ambient_entry);
     sp->pigment = lane_colour(w, CC_PIGMENT, sp->pig, lane, n);
     sp->x = v3_madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(v3_dot(h->point, h->point))));
     sp->cb = fr->cb;
@@ -1418,8 +1441,10 @@ static int shade_packet(const rs_integrator *it, const int *lane, int n, shade_p
     const rs_scene *sc = it->scene;
     const rs_finish *f = &sp->h->surface->finish;
     int nl = it->n_lanes;
-    if (shared_halves(nl, e, source0, lane, n, sp->emission, NULL) != 0 ||
-        shared_halves(nl, e, 0, lane, n, sp->ambient, NULL) != 0)
+    /* a colour 0 in every lane emits in none */
+    if ((!sp->emission_entry->dark &&
+         shared_halves(nl, e, source0, lane, n, sp->emission, NULL) != 0) ||
+        (!sp->ambient_entry->dark && shared_halves(nl, e, 0, lane, n, sp->ambient, NULL) != 0))
         return -1;
     for (size_t q = 0; q < sc->n_lights; q++) {
         for (int k = 0; k < n; k++) {
