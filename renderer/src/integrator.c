@@ -101,6 +101,8 @@ struct rs_integrator {
     double *lane_light;         /* [k * n_lanes + lane]: band_light of light
                                    k in each lane, once per render */
     double *lane_background;    /* per lane: the background's emission */
+    double *background_half;    /* per lane: the shared vector of its halves */
+    unsigned char *background_has; /* (halves_every_lane) */
     int interferes;             /* some rays may add as amplitudes: a coherent
                                    source or a crystal lens */
     double *lane_xyz;           /* [lane * 3 + c]: what one unit of the lane's
@@ -118,6 +120,7 @@ struct rs_integrator {
  * asks for it (a packet split at a dispersive lens has one lane).  An entry's
  * lane values are valid where their stamp is the entry's generation. */
 enum { CC_EMISSION, CC_AMBIENT, CC_PIGMENT, CC_MIRROR_MAX, CC_MIRROR_MIN, CC_KINDS };
+#define CC_HALVES 2 /* the uses that emit (CC_EMISSION, CC_AMBIENT): halves kept */
 #define RS_COLOUR_CACHE 64      /* most entries per table, a power of 2 */
 #define RS_COLOUR_CACHE_LANES 16384 /* entries x lanes per table at most */
 
@@ -126,6 +129,10 @@ typedef struct colour_entry {
     unsigned gen; /* 0: unused */
     int n_valid;  /* lanes of this generation evaluated */
     int dark;     /* 1: every lane is evaluated, and is 0 */
+    /* an emission's or ambient colour's shared vector of halves in every
+     * lane (halves_every_lane), once every lane is evaluated; else NULL */
+    const double *half;
+    const unsigned char *half_has;
 } colour_entry;
 
 
@@ -185,6 +192,8 @@ struct rs_worker {
     size_t cc_n;          /* entries used per table */
     double *cc_val;       /* [(kind * cc_n + entry) * n_lanes + lane] */
     unsigned *cc_stamp;   /* the same */
+    double *cc_half;      /* the same, of CC_EMISSION and CC_AMBIENT */
+    unsigned char *cc_half_has; /* the same */
     rs_work work;         /* what this worker has traced (rs_worker_work) */
 };
 
@@ -408,6 +417,8 @@ void rs_integrator_destroy(rs_integrator *it)
     rs_lane_classes_destroy(it->classes);
     free(it->lane_light);
     free(it->lane_background);
+    free(it->background_half);
+    free(it->background_has);
     free(it->lane_xyz);
     free(it);
 }
@@ -426,7 +437,10 @@ rs_worker *rs_worker_create(const rs_integrator *it)
         w->cc_n /= 2;
     w->cc_val = calloc((size_t)CC_KINDS * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_val);
     w->cc_stamp = calloc((size_t)CC_KINDS * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_stamp);
-    if (!w->lane_all || !w->lane_value || !w->lane_at || !w->cc_val || !w->cc_stamp) {
+    w->cc_half = calloc((size_t)CC_HALVES * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_half);
+    w->cc_half_has = calloc((size_t)CC_HALVES * w->cc_n * (size_t)it->n_lanes, 1);
+    if (!w->lane_all || !w->lane_value || !w->lane_at || !w->cc_val || !w->cc_stamp ||
+        !w->cc_half || !w->cc_half_has) {
         rs_worker_destroy(w);
         return NULL;
     }
@@ -485,6 +499,8 @@ void rs_worker_destroy(rs_worker *w)
     free(w->lane_at);
     free(w->cc_val);
     free(w->cc_stamp);
+    free(w->cc_half);
+    free(w->cc_half_has);
     free(w->pixel.r);
     free(w->pixel.lane);
     free(w->pixel.I);
@@ -665,20 +681,44 @@ static double band_light_eval(const rs_integrator *it, const band *b, int k)
 }
 
 
+/* The shared vector of the halves of a source for every lane 0..nl-1: a
+ * lane that emits (lane_emits) has the ray with intensity 0.5 v[l], the
+ * others have +0.  Every lane in one pass, the lanes kept by a bit mask
+ * (no branch: it vectorizes). */
+RS_WIDE static void halves_every_lane(int nl, const double *restrict v,
+                                      const unsigned char *restrict got, double *restrict I,
+                                      unsigned char *restrict has)
+{
+    for (int l = 0; l < nl; l++) {
+        unsigned char keep = got ? got[l] != 0 : v[l] != 0.0;
+        double x = 0.5 * v[l];
+        uint64_t bits;
+        memcpy(&bits, &x, sizeof bits);
+        bits &= (uint64_t)0 - keep;
+        has[l] = keep;
+        memcpy(&I[l], &bits, sizeof bits);
+    }
+}
+
 /* The tables of light and background per lane (see struct rs_integrator). */
 static int make_lane_tables(rs_integrator *it)
 {
     size_t nl = it->scene->n_lights, n = (size_t)it->n_lanes;
     it->lane_light = calloc(nl * n + 1, sizeof *it->lane_light);
     it->lane_background = calloc(n + 1, sizeof *it->lane_background);
+    it->background_half = calloc(n + 1, sizeof *it->background_half);
+    it->background_has = calloc(n + 1, 1);
     it->lane_xyz = calloc(3 * n + 1, sizeof *it->lane_xyz);
-    if (!it->lane_light || !it->lane_background || !it->lane_xyz)
+    if (!it->lane_light || !it->lane_background || !it->background_half ||
+        !it->background_has || !it->lane_xyz)
         return -1;
     for (size_t k = 0; k < nl; k++)
         for (size_t i = 0; i < n; i++)
             it->lane_light[k * n + i] = band_light_eval(it, &it->lanes[i], (int)k);
     for (size_t i = 0; i < n; i++)
         it->lane_background[i] = band_emission(&it->lanes[i], it->scene->background);
+    halves_every_lane(it->n_lanes, it->lane_background, NULL, it->background_half,
+                      it->background_has);
     for (size_t i = 0; i < n && it->opts.mode != RS_MODE_RGB; i++) {
         const band *b = &it->lanes[i];
         if (b->kind == BAND_CONTINUUM) {
@@ -720,6 +760,8 @@ static const double *lane_colour_fill(rs_worker *w, int kind, size_t e, rs_color
         ce->c = c;
         ce->n_valid = 0;
         ce->dark = 0;
+        ce->half = NULL;
+        ce->half_has = NULL;
         if (++ce->gen == 0) { /* wrapped: no stamp may match a new generation */
             memset(stamp, 0, (size_t)it->n_lanes * sizeof *stamp);
             ce->gen = 1;
@@ -741,6 +783,11 @@ static const double *lane_colour_fill(rs_worker *w, int kind, size_t e, rs_color
         for (int l = 0; l < it->n_lanes; l++)
             dark &= !(v[l] != 0.0);
         ce->dark = dark;
+        if (kind < CC_HALVES) {
+            halves_every_lane(it->n_lanes, v, NULL, w->cc_half + at, w->cc_half_has + at);
+            ce->half = w->cc_half + at;
+            ce->half_has = w->cc_half_has + at;
+        }
     }
     return v;
 }
@@ -1370,33 +1417,16 @@ static inline int lane_emits(const double *v, const unsigned char *got, int l)
     return got ? got[l] != 0 : v[l] != 0.0;
 }
 
-/* The shared vector of the halves of a source for every lane 0..nl-1: a
- * lane that emits (lane_emits) has the ray with intensity 0.5 v[l], the
- * others have +0.  Every lane in one pass, the lanes kept by a bit mask
- * (no branch: it vectorizes). */
-RS_WIDE static void halves_every_lane(int nl, const double *restrict v,
-                                      const unsigned char *restrict got, double *restrict I,
-                                      unsigned char *restrict has)
-{
-    for (int l = 0; l < nl; l++) {
-        unsigned char keep = got ? got[l] != 0 : v[l] != 0.0;
-        double x = 0.5 * v[l];
-        uint64_t bits;
-        memcpy(&bits, &x, sizeof bits);
-        bits &= (uint64_t)0 - keep;
-        has[l] = keep;
-        memcpy(&I[l], &bits, sizeof bits);
-    }
-}
-
 /* The pair of shared halves (emit_halves for several lanes at once) of
  * one source for the lanes lane[0..n) that emit there: those with
  * got[l] set (got NULL: those with v[l] != 0), l = lane[k], radiance
  * v[l]; none when no lane emits.  The vector of a packet of every lane
- * (n == nl: its lanes are 0..nl-1 in some order) is filled in a loop that
- * vectorizes.  Returns -1 when out of memory. */
+ * (n == nl: its lanes are 0..nl-1 in some order) is half and half_has,
+ * halves_every_lane of v kept with it, where given (not NULL), else
+ * filled in a loop that vectorizes.  Returns -1 when out of memory. */
 static int shared_halves(int nl, const emit_ctx *e, int source, const int *lane, int n,
-                         const double *v, const unsigned char *got)
+                         const double *v, const unsigned char *got, const double *half,
+                         const unsigned char *half_has)
 {
     bundle *out = e->out;
     double *I;
@@ -1411,7 +1441,10 @@ static int shared_halves(int nl, const emit_ctx *e, int source, const int *lane,
         return -1;
     half_ray(e, source, 0, r);
     r->intensity = 0.5 * v[lane[k]];
-    if (every) {
+    if (every && half) {
+        memcpy(I, half, (size_t)nl * sizeof *I);
+        memcpy(has, half_has, (size_t)nl);
+    } else if (every) {
         halves_every_lane(nl, v, got, I, has);
     } else {
         for (; k < n; k++) {
@@ -1443,8 +1476,11 @@ static int shade_packet(const rs_integrator *it, const int *lane, int n, shade_p
     int nl = it->n_lanes;
     /* a colour 0 in every lane emits in none */
     if ((!sp->emission_entry->dark &&
-         shared_halves(nl, e, source0, lane, n, sp->emission, NULL) != 0) ||
-        (!sp->ambient_entry->dark && shared_halves(nl, e, 0, lane, n, sp->ambient, NULL) != 0))
+         shared_halves(nl, e, source0, lane, n, sp->emission, NULL, sp->emission_entry->half,
+                       sp->emission_entry->half_has) != 0) ||
+        (!sp->ambient_entry->dark &&
+         shared_halves(nl, e, 0, lane, n, sp->ambient, NULL, sp->ambient_entry->half,
+                       sp->ambient_entry->half_has) != 0))
         return -1;
     for (size_t q = 0; q < sc->n_lights; q++) {
         for (int k = 0; k < n; k++) {
@@ -1452,7 +1488,8 @@ static int shade_packet(const rs_integrator *it, const int *lane, int n, shade_p
             double rho = sp->pigment[l] * f->diffuse;
             fr->light_got[l] = lit(f, rho) && light_term(it, sp, rho, l, q, &fr->light_v[l]);
         }
-        if (shared_halves(nl, e, src_light(it, (int)q), lane, n, fr->light_v, fr->light_got) != 0)
+        if (shared_halves(nl, e, src_light(it, (int)q), lane, n, fr->light_v, fr->light_got,
+                          NULL, NULL) != 0)
             return -1;
     }
     return 0;
@@ -1693,7 +1730,6 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
                 double *Io;
                 unsigned char *has;
                 int first;
-                lp_ray ray = *gr;
                 size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
                 if (!(r = bundle_push_shared(out, nl, 0, &Io, &has)))
                     return -1;
@@ -1705,8 +1741,8 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
                     out->ns--;
                     break;
                 }
-                ray.intensity = Io[first];
-                *r = ray;
+                *r = *gr;
+                r->intensity = Io[first];
             }
             if (split)
                 r->ch = rs_coherence_split(r->ch, hit, q[j].depth, q[j].kind != LP_KIND_REFLECT);
@@ -1753,7 +1789,8 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
         if (e.wavelet < 0)
             return;
         if (n > 1) {
-            shared_halves(it->n_lanes, &e, 1, lane, n, L, NULL);
+            shared_halves(it->n_lanes, &e, 1, lane, n, L, NULL, it->background_half,
+                          it->background_has);
         } else {
             e.lane = lane[0];
             emit_halves(&e, 1, L[lane[0]]);
