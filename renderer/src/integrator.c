@@ -32,6 +32,7 @@
  * k from a lens hit at level L is level L + k; a ray that needs a level
  * beyond max_trace_level is black.  A branch whose bound on its weight
  * falls below the cut-off is not traced. */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -1667,6 +1668,17 @@ RS_WIDE static void scale_lanes(int nl, const double *restrict cI,
     }
 }
 
+/* scale_lanes where no lane failed and 0 < gI <= DBL_MAX: every lane's
+ * gI (cI[k] / I0) as it stands, has the ray's own (copied by the caller):
+ * a lane without the ray has cI[k] = +0 (bundle_push_shared), so it gets
+ * gI (+0 / I0) = +0 as scale_lanes gives it. */
+RS_WIDE static void scale_kept_lanes(int nl, const double *restrict cI, double I0, double gI,
+                                     double *restrict Io)
+{
+    for (int k = 0; k < nl; k++)
+        Io[k] = gI * (cI[k] / I0);
+}
+
 /* Gather the rays of fr->child (lanes of equal optics at this lens) along
  * query j, appending the outputs to out, each with its ray's lanes.
  * Rays that differ only in intensity (a shared ray's lanes, and rays of
@@ -1733,7 +1745,12 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
                 size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
                 if (!(r = bundle_push_shared(out, nl, 0, &Io, &has)))
                     return -1;
-                scale_lanes(nl, c->I + s, c->has + s, fr->bad, I0, gr->intensity, Io, has);
+                if (!any_bad && gr->intensity > 0.0 && gr->intensity <= DBL_MAX) {
+                    scale_kept_lanes(nl, c->I + s, I0, gr->intensity, Io);
+                    memcpy(has, c->has + s, (size_t)nl);
+                } else {
+                    scale_lanes(nl, c->I + s, c->has + s, fr->bad, I0, gr->intensity, Io, has);
+                }
                 for (first = 0; first < nl && !has[first]; first++)
                     ;
                 if (first == nl) { /* every lane failed: no ray */
