@@ -21,13 +21,8 @@
 /* Ways per group. */
 #define WL 8
 
-/* A loop over the lanes of a group, left a loop (not unrolled into
- * lanes of scalar code), so that the vectorizer takes it whole. */
-#if defined(__GNUC__)
-#define WL_LANES(i) _Pragma("GCC unroll 1") for (int i = 0; i < WL; i++)
-#else
-#define WL_LANES(i) for (int i = 0; i < WL; i++)
-#endif
+/* A loop over the lanes of a group (lanes.h). */
+#define WL_LANES(i) LP__LANE_LOOP(i, WL)
 
 /* The lanes of a group of ways. */
 typedef struct wl_lanes {

@@ -24,13 +24,8 @@
 /* Rays per group. */
 #define GL 4
 
-/* A loop over the lanes of a group, left a loop (not unrolled into lanes
- * of scalar code), so that the vectorizer takes it whole. */
-#if defined(__GNUC__)
-#define GL_LANES(i) _Pragma("GCC unroll 1") for (int i = 0; i < GL; i++)
-#else
-#define GL_LANES(i) for (int i = 0; i < GL; i++)
-#endif
+/* A loop over the lanes of a group (lanes.h). */
+#define GL_LANES(i) LP__LANE_LOOP(i, GL)
 
 /* The lanes of a group. */
 typedef struct gl_lanes {
