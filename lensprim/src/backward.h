@@ -48,6 +48,10 @@ struct lp_backward {
     int ways;
     lp__bw_way light[LP_MAX_DEPTH]; /* light[j]: node j, light arriving from inside */
     lp__bw_way entry[LP_MAX_DEPTH]; /* entry[q]: where query q's light enters */
+    /* per query: 1 when no node of its way is under total internal
+     * reflection or at normal incidence (its fields stay real: a gather
+     * may take its rays in lanes, lp__gather_lanes) */
+    unsigned char real_way[LP_MAX_DEPTH];
 };
 
 /* Add the query of the given depth, kind and surface leaving node
@@ -69,5 +73,26 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
  * only by gathering, set up the ways of every gather of its queries
  * (not through a crystal). */
 void lp__backward_built(lp_backward *bw);
+
+/* The way where the light of query qi enters the lens, and the way of
+ * node j of the light's way back (trace_backward.c), into *w. */
+void lp__backward_entry_way(const lp_backward *bw, size_t qi, lp__bw_way *w);
+void lp__backward_light_way(const lp_backward *bw, int j, lp__bw_way *w);
+
+/* Gather bundle[0..n) along query q, whose way keeps fields real
+ * (bw->real_way[q]), into res as gathering them one by one does, the same
+ * bits, a few rays at a time in lanes (gather_lanes.c).  Returns how many
+ * rays it gathered, in order: n, or fewer where a ray fails its checks
+ * (the caller gathers it and the rest one by one, which reports it) or
+ * where an outgoing ray cannot be stored (*st LP_ERROR_NO_MEMORY, with
+ * err; else *st is LP_OK). */
+size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
+                        lp_result *res, lp_status *st, lp_error *err);
+
+/* Every query's entry way and the light's ways at nodes 1..deepest-1,
+ * into bw->entry and bw->light: those of lp__backward_entry_way and
+ * lp__backward_light_way, bit for bit, set up in lanes
+ * (backward_ways.c). */
+void lp__backward_ways(lp_backward *bw, int deepest);
 
 #endif

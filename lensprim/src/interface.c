@@ -12,7 +12,7 @@
 /* The s axis at normal incidence: the incoming field's own direction
  * (its real part, or its imaginary part if that is all it has), else any
  * axis perpendicular to d. */
-static lp_vec3 hint_axis(lp_vec3 d, const lp__cvec3 *hint)
+lp_vec3 lp__hint_axis(lp_vec3 d, const lp__cvec3 *hint)
 {
     lp_vec3 e = hint ? cv3_re(*hint) : v3(0, 0, 0);
     if (hint && v3_dot(e, e) == 0.0)
@@ -21,22 +21,10 @@ static lp_vec3 hint_axis(lp_vec3 d, const lp__cvec3 *hint)
     return v3_dot(e, e) > 0.0 ? v3_normalize(e) : v3_any_perp(d);
 }
 
-int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
-                   const lp__cvec3 *hint)
-{
-    lp__node_setup_fresnel(node, d, normal, n1, n2);
-    lp_vec3 s = v3_cross(d, node->n);
-    double sl2 = v3_dot(s, s);
-    node->normal = !(sl2 > 1e-18);
-    node->s = node->normal ? hint_axis(d, hint) : v3_scale(s, 1.0 / sqrt(sl2));
-    node->p = v3_cross(d, node->s);
-    return node->f.tir;
-}
-
 void lp__node_refit(lp__node *node, const lp__cvec3 *E)
 {
     if (node->normal) {
-        node->s = hint_axis(node->d, E);
+        node->s = lp__hint_axis(node->d, E);
         node->p = v3_cross(node->d, node->s);
     }
 }
@@ -108,18 +96,6 @@ static inline void transmit_on(const lp__node *node, const lp__axes *ax, lp_mode
         double k = sqrt(T > 0.0 ? T : 0.0);
         out->E = combine(real, k * es, node->s, k * ep, pt);
     }
-}
-
-void lp__node_reflect_axes(const lp__node *node, lp__axes *ax)
-{
-    ax->dir = lp__node_reflect_dir(node);
-    ax->p = v3_cross(ax->dir, node->s);
-}
-
-void lp__node_transmit_axes(const lp__node *node, lp__axes *ax)
-{
-    ax->dir = lp__node_transmit_dir(node);
-    ax->p = v3_cross(ax->dir, node->s);
 }
 
 void lp__node_reflect_on(const lp__node *node, const lp__axes *ax, lp_mode mode,

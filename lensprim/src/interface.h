@@ -40,14 +40,6 @@ typedef struct lp__node {
     int normal;       /* normal incidence: s was taken from the hint */
 } lp__node;
 
-/* Set up a node: light along unit d meets a surface with unit normal
- * `normal` (either orientation) going from index n1 into n2.  hint is a
- * field to take the s axis from at normal incidence (the s/p split is
- * undefined there; any axis gives the same result, the incoming field's
- * own keeps the frame).  Returns 1 under total internal reflection. */
-int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1, double n2,
-                   const lp__cvec3 *hint);
-
 /* The geometry and Fresnel factors of lp__node_setup alone (no s and p
  * axes: for the directions and powers of the branches, not their
  * fields).  Returns 1 under total internal reflection.  Inline, as the
@@ -77,6 +69,29 @@ static inline lp_vec3 lp__node_transmit_dir(const lp__node *node)
 {
     double eta = node->f.eta, ci = node->cos_i, ct = node->f.cos_t;
     return v3_normalize(v3_madd(v3_scale(node->d, eta), node->n, eta * ci - ct));
+}
+
+/* The s axis at normal incidence: that of the field hint (NULL: any
+ * axis perpendicular to d). */
+lp_vec3 lp__hint_axis(lp_vec3 d, const lp__cvec3 *hint);
+
+/* Set up a node: light along unit d meets a surface with unit normal
+ * `normal` (either orientation) going from index n1 into n2.  hint is a
+ * field to take the s axis from at normal incidence (the s/p split is
+ * undefined there; any axis gives the same result, the incoming field's
+ * own keeps the frame).  Returns 1 under total internal reflection.
+ * Inline: every node of a trace and every way of a polarized build sets
+ * up one. */
+static inline int lp__node_setup(lp__node *node, lp_vec3 d, lp_vec3 normal, double n1,
+                                 double n2, const lp__cvec3 *hint)
+{
+    lp__node_setup_fresnel(node, d, normal, n1, n2);
+    lp_vec3 s = v3_cross(d, node->n);
+    double sl2 = v3_dot(s, s);
+    node->normal = !(sl2 > 1e-18);
+    node->s = node->normal ? lp__hint_axis(d, hint) : v3_scale(s, 1.0 / sqrt(sl2));
+    node->p = v3_cross(d, node->s);
+    return node->f.tir;
 }
 
 /* A node set up once for any field (hint NULL) serves every field, except
@@ -129,8 +144,17 @@ typedef struct lp__axes {
     lp_vec3 p;    /* dir x s */
 } lp__axes;
 
-void lp__node_reflect_axes(const lp__node *node, lp__axes *ax);
-void lp__node_transmit_axes(const lp__node *node, lp__axes *ax);
+static inline void lp__node_reflect_axes(const lp__node *node, lp__axes *ax)
+{
+    ax->dir = lp__node_reflect_dir(node);
+    ax->p = v3_cross(ax->dir, node->s);
+}
+
+static inline void lp__node_transmit_axes(const lp__node *node, lp__axes *ax)
+{
+    ax->dir = lp__node_transmit_dir(node);
+    ax->p = v3_cross(ax->dir, node->s);
+}
 
 /* The branches of G on axes computed for the node as it is: the same as
  * lp__node_reflect_amp / lp__node_transmit_amp. */

@@ -43,6 +43,14 @@
 /* Lanes per group. */
 #define LP__LANES 64
 
+/* A loop over the n lanes of a group, left a loop (not unrolled into
+ * lanes of scalar code), so that the vectorizer takes it whole. */
+#if defined(__GNUC__)
+#define LP__LANE_LOOP(i, n) _Pragma("GCC unroll 1") for (int i = 0; i < (n); i++)
+#else
+#define LP__LANE_LOOP(i, n) for (int i = 0; i < (n); i++)
+#endif
+
 /* The lens as the loops read it (a copy, so that no store to the lanes
  * can be taken to change it). */
 typedef struct lp__lane_lens {

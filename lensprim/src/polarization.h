@@ -27,18 +27,27 @@ int lp__field_split_elliptic(const lp__cvec3 *E, double total, lp_vec3 dir,
  * gives one part carrying all the power.  A zero field gives 0 parts.
  * Returns the number of parts.  total is the field's power cv3_norm2(*E),
  * which the caller has; inline, since a real field (every field before a
- * total internal reflection) is one part at once. */
-static inline int lp__field_split(const lp__cvec3 *E, double total, lp_vec3 dir,
-                                  lp__linear_part part[2])
+ * total internal reflection) is one part at once: lp__field_split_real,
+ * for a field held as a real vector e (power total = v3_dot(e, e), the
+ * bits of cv3_norm2 of its complex form). */
+static inline int lp__field_split_real(lp_vec3 e, double total, lp_vec3 dir,
+                                       lp__linear_part part[2])
 {
     if (!(total > 0.0))
         return 0;
-    if (cv3_is_real(*E)) { /* linear already: psi = 0, A = E, B = 0 */
-        part[0].intensity = total;
-        part[0].vp = lp__unit_perp(cv3_re(*E), dir);
-        part[0].phase = 0.0;
-        return 1;
-    }
+    part[0].intensity = total; /* linear already: psi = 0, A = e, B = 0 */
+    part[0].vp = lp__unit_perp(e, dir);
+    part[0].phase = 0.0;
+    return 1;
+}
+
+static inline int lp__field_split(const lp__cvec3 *E, double total, lp_vec3 dir,
+                                  lp__linear_part part[2])
+{
+    if (cv3_is_real(*E))
+        return lp__field_split_real(cv3_re(*E), total, dir, part);
+    if (!(total > 0.0))
+        return 0;
     return lp__field_split_elliptic(E, total, dir, part);
 }
 

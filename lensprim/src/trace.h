@@ -78,6 +78,54 @@ lp_status lp__leave(const lp_lens *lens, const lp_trace_args *a, lp_result *res,
                     lp_kind kind, int surface, uint64_t path, lp_error *err);
 
 
+/* Store the outgoing ray k (intensity, world field direction vp, phase
+ * relative to the payload's) of a field leaving at x, with the wave bits
+ * `waves`, and add its power to res->out. */
+static inline lp_status lp__emit_ray(lp_result *res, const lp__exit *x, const lp__payload *pl,
+                                     int depth, lp_kind kind, int surface, uint64_t path,
+                                     uint64_t waves, int k, double intensity, lp_vec3 vp,
+                                     double phase, lp_error *err)
+{
+    lp_out_ray *o = lp__result_push(res);
+    if (!o)
+        return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
+    o->ray.origin = x->world_origin;
+    o->ray.dir = x->world_dir;
+    o->ray.lambda_nm = pl->lambda_nm;
+    o->ray.intensity = intensity;
+    o->ray.vp = vp;
+    o->ray.kphi = pl->kphi;
+    o->ray.op = pl->op;
+    o->ray.phase = lp__wrap_phase(pl->phase + phase);
+    o->ray.ch = pl->ch;
+    o->depth = depth;
+    o->kind = kind;
+    o->surface = surface;
+    o->part = k;
+    o->path = path;
+    o->waves = waves;
+    res->out += intensity;
+    return LP_OK;
+}
+
+/* The linear parts part[0..n) of a field leaving at x as rays, each with
+ * the wave bits `waves`. */
+static inline lp_status lp__emit_linear(const lp_lens *lens, lp_result *res,
+                                        const lp__linear_part *part, int n, const lp__exit *x,
+                                        const lp__payload *pl, int depth, lp_kind kind,
+                                        int surface, uint64_t path, uint64_t waves,
+                                        lp_error *err)
+{
+    for (int k = 0; k < n; k++) {
+        lp_status st = lp__emit_ray(res, x, pl, depth, kind, surface, path, waves, k,
+                                    part[k].intensity, lp__to_world_dir(lens, part[k].vp),
+                                    part[k].phase, err);
+        if (st != LP_OK)
+            return st;
+    }
+    return LP_OK;
+}
+
 /* The rays of field E (power `power`) leaving at x, each with the wave
  * bits `waves`: lp__emit_power and lp__emit_gathered in one pass. */
 static inline lp_status lp__emit_parts(const lp_lens *lens, lp_result *res, const lp__cvec3 *E,
@@ -87,48 +135,58 @@ static inline lp_status lp__emit_parts(const lp_lens *lens, lp_result *res, cons
 {
     lp__linear_part part[2];
     int n = lp__field_split(E, power, x->d, part);
+    return lp__emit_linear(lens, res, part, n, x, pl, depth, kind, surface, path, waves, err);
+}
 
-    for (int k = 0; k < n; k++) {
-        lp_out_ray *o = lp__result_push(res);
-        if (!o)
-            return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory storing outgoing rays");
-        o->ray.origin = x->world_origin;
-        o->ray.dir = x->world_dir;
-        o->ray.lambda_nm = pl->lambda_nm;
-        o->ray.intensity = part[k].intensity;
-        o->ray.vp = lp__to_world_dir(lens, part[k].vp);
-        o->ray.kphi = pl->kphi;
-        o->ray.op = pl->op;
-        o->ray.phase = lp__wrap_phase(pl->phase + part[k].phase);
-        o->ray.ch = pl->ch;
-        o->depth = depth;
-        o->kind = kind;
-        o->surface = surface;
-        o->part = k;
-        o->path = path;
-        o->waves = waves;
-        res->out += part[k].intensity;
-    }
+/* The accounts of a gathered bundle ray of power `in` once its rays are
+ * stored (res->out was `before`): `absorbed` went into the glass, the rest
+ * not leaving is truncated. */
+static inline void lp__gathered_rest(lp_result *res, double before, double in, double absorbed)
+{
+    res->absorbed_glass += absorbed;
+    res->truncated += in - (res->out - before) - absorbed;
+}
+
+/* Emit the linear parts part[0..n) of a gathered field (of a bundle ray
+ * of power `in`, of which `absorbed` went into the glass) as the rays of
+ * query q, leaving the lens at x; the rest of `in` is counted as
+ * truncated (inline: every gathered ray leaves by it). */
+static inline lp_status lp__emit_gathered_parts(const lp_lens *lens, lp_result *res,
+                                                const lp__linear_part *part, int n,
+                                                const lp__exit *x, const lp__payload *pl,
+                                                const lp_query *q, double in, double absorbed,
+                                                lp_error *err)
+{
+    double before = res->out;
+    lp_status st = lp__emit_linear(lens, res, part, n, x, pl, q->depth, q->kind, q->surface,
+                                   q->path, q->waves, err);
+    if (st != LP_OK)
+        return st;
+    lp__gathered_rest(res, before, in, absorbed);
     return LP_OK;
 }
 
-/* Emit a gathered field E (of a bundle ray of power `in`, of which
- * `absorbed` went into the glass) as the rays of query q, leaving the
- * lens at x; the rest of `in` is counted as truncated (inline: every
- * gathered ray leaves by it). */
+/* lp__emit_gathered_parts of the gathered field E. */
 static inline lp_status lp__emit_gathered(const lp_lens *lens, lp_result *res,
                                           const lp__cvec3 *E, const lp__exit *x,
                                           const lp__payload *pl, const lp_query *q, double in,
                                           double absorbed, lp_error *err)
 {
-    double before = res->out;
-    lp_status st = lp__emit_parts(lens, res, E, cv3_norm2(*E), x, pl, q->depth, q->kind,
-                                  q->surface, q->path, q->waves, err);
-    if (st != LP_OK)
-        return st;
-    res->absorbed_glass += absorbed;
-    res->truncated += in - (res->out - before) - absorbed;
-    return LP_OK;
+    lp__linear_part part[2];
+    int n = lp__field_split(E, cv3_norm2(*E), x->d, part);
+    return lp__emit_gathered_parts(lens, res, part, n, x, pl, q, in, absorbed, err);
+}
+
+/* lp__emit_gathered of a real field e (polarized, before any total
+ * internal reflection), without its complex form: the same bits. */
+static inline lp_status lp__emit_gathered_real(const lp_lens *lens, lp_result *res, lp_vec3 e,
+                                               const lp__exit *x, const lp__payload *pl,
+                                               const lp_query *q, double in, double absorbed,
+                                               lp_error *err)
+{
+    lp__linear_part part[2];
+    int n = lp__field_split_real(e, v3_dot(e, e), x->d, part);
+    return lp__emit_gathered_parts(lens, res, part, n, x, pl, q, in, absorbed, err);
 }
 
 /* The unit vector along the part of v perpendicular to the unit d; *ok

@@ -92,7 +92,7 @@ static double node_weight(const lp__node *nd, lp_mode mode, int reflect)
 
 /* The node where light answering query qi enters the lens (any field):
  * it reflects off the outside (depth 1) or refracts in. */
-static void entry_way(const lp_backward *bw, size_t qi, lp__bw_way *w)
+void lp__backward_entry_way(const lp_backward *bw, size_t qi, lp__bw_way *w)
 {
     const lp_query *q = &bw->query[qi];
     lp__node_setup(&w->node, v3_neg(bw->query_dir[qi]), bw->node[q->depth].n,
@@ -106,7 +106,7 @@ static void entry_way(const lp_backward *bw, size_t qi, lp__bw_way *w)
 
 /* The node j of the way back, light arriving from inside (any field): it
  * reflects there (j > 1) or refracts out (j = 1). */
-static void light_way(const lp_backward *bw, int j, lp__bw_way *w)
+void lp__backward_light_way(const lp_backward *bw, int j, lp__bw_way *w)
 {
     lp__node_setup(&w->node, v3_neg(bw->node[j].e_out), bw->node[j].n, bw->optics.n_glass,
                    bw->optics.n_medium, NULL);
@@ -123,13 +123,19 @@ void lp__backward_built(lp_backward *bw)
     if (bw->args.mode != LP_MODE_POLARIZED || lp__xback_active(bw->xb))
         return;
     int deepest = 0;
-    for (size_t qi = 0; qi < bw->n_queries; qi++) {
-        entry_way(bw, qi, &bw->entry[qi]);
+    for (size_t qi = 0; qi < bw->n_queries; qi++)
         if (bw->query[qi].depth > deepest)
             deepest = bw->query[qi].depth;
-    }
+    lp__backward_ways(bw, deepest);
+    /* the ways that keep a field real: up to node j - 1 (real[j]) */
+    unsigned char real[LP_MAX_DEPTH + 1];
+    real[1] = 1;
     for (int j = 1; j < deepest; j++)
-        light_way(bw, j, &bw->light[j]);
+        real[j + 1] = real[j] && !bw->light[j].node.normal && !bw->light[j].node.f.tir;
+    for (size_t qi = 0; qi < bw->n_queries; qi++) {
+        const lp__node *nd = &bw->entry[qi].node;
+        bw->real_way[qi] = real[bw->query[qi].depth] && !nd->normal && !nd->f.tir;
+    }
     bw->ways = 1;
 }
 
@@ -378,9 +384,9 @@ static lp_status gather_one(const lp_backward *bw, size_t qi, const lp__bw_way *
         }
         pl.kphi += flip;
     }
-    if (real)
-        E = cv3_real(e, 1.0);
     res->nodes += (size_t)k;
+    if (real)
+        return lp__emit_gathered_real(bw->lens, res, e, &bw->exit, &pl, q, I0, absorbed, err);
     return lp__emit_gathered(bw->lens, res, &E, &bw->exit, &pl, q, I0, absorbed, err);
 }
 
@@ -401,13 +407,19 @@ lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bund
         lp__bw_way way[LP_MAX_DEPTH + 1]; /* this gather's own: way[k] the entry */
         if (!bw->ways) {
             int k = bw->query[q].depth;
-            entry_way(bw, q, &way[k]);
+            lp__backward_entry_way(bw, q, &way[k]);
             for (int j = 1; j < k; j++)
-                light_way(bw, j, &way[j]);
+                lp__backward_light_way(bw, j, &way[j]);
             entry = &way[k];
             light = way;
         }
-        for (size_t i = 0; i < n; i++)
+        size_t i = 0;
+        if (bw->ways && bw->real_way[q]) {
+            i = lp__gather_lanes(bw, q, bundle, n, out, &st, err);
+            if (st != LP_OK)
+                return st;
+        }
+        for (; i < n; i++)
             if ((st = gather_one(bw, q, entry, light, &bundle[i], out, err)) != LP_OK)
                 return st;
     }

@@ -32,11 +32,6 @@ void rs_wavelets_free(rs_wavelets *t)
     t->n = t->cap = 0;
 }
 
-uint64_t rs_coherence_ch(long index, int source, int half)
-{
-    return ((uint64_t)index << 32) | (2u * (uint64_t)source + (uint64_t)half);
-}
-
 #define RS_COH_SPLIT 0x80000000u
 #define RS_COH_SOURCE 0xffffu
 

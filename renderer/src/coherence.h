@@ -58,8 +58,12 @@ typedef struct rs_wavelets {
 long rs_wavelets_push(rs_wavelets *t, const rs_wavelet *w);
 void rs_wavelets_free(rs_wavelets *t);
 
-/* The ch of a ray of source `source`, half `half`, leaving wavelet `index`. */
-uint64_t rs_coherence_ch(long index, int source, int half);
+/* The ch of a ray of source `source`, half `half`, leaving wavelet `index`
+ * (inline: every emitted ray has one). */
+static inline uint64_t rs_coherence_ch(long index, int source, int half)
+{
+    return ((uint64_t)index << 32) | (2u * (uint64_t)source + (uint64_t)half);
+}
 
 /* Rays a crystal lens splits into o and e rays.  The rays one lens hit
  * returns on queries of one depth and kind, grown from one channel, come

@@ -32,6 +32,7 @@
  * k from a lens hit at level L is level L + k; a ray that needs a level
  * beyond max_trace_level is black.  A branch whose bound on its weight
  * falls below the cut-off is not traced. */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -47,6 +48,7 @@
 #include "shapes.h"
 #include "emitter.h"
 #include "support/vec.h"
+#include "wide.h"
 
 #define RS_MAX_FRAMES 400
 #define RS_PI 3.14159265358979323846
@@ -100,6 +102,8 @@ struct rs_integrator {
     double *lane_light;         /* [k * n_lanes + lane]: band_light of light
                                    k in each lane, once per render */
     double *lane_background;    /* per lane: the background's emission */
+    double *background_half;    /* per lane: the shared vector of its halves */
+    unsigned char *background_has; /* (halves_every_lane) */
     int interferes;             /* some rays may add as amplitudes: a coherent
                                    source or a crystal lens */
     double *lane_xyz;           /* [lane * 3 + c]: what one unit of the lane's
@@ -117,6 +121,7 @@ struct rs_integrator {
  * asks for it (a packet split at a dispersive lens has one lane).  An entry's
  * lane values are valid where their stamp is the entry's generation. */
 enum { CC_EMISSION, CC_AMBIENT, CC_PIGMENT, CC_MIRROR_MAX, CC_MIRROR_MIN, CC_KINDS };
+#define CC_HALVES 2 /* the uses that emit (CC_EMISSION, CC_AMBIENT): halves kept */
 #define RS_COLOUR_CACHE 64      /* most entries per table, a power of 2 */
 #define RS_COLOUR_CACHE_LANES 16384 /* entries x lanes per table at most */
 
@@ -124,6 +129,11 @@ typedef struct colour_entry {
     rs_color c;
     unsigned gen; /* 0: unused */
     int n_valid;  /* lanes of this generation evaluated */
+    int dark;     /* 1: every lane is evaluated, and is 0 */
+    /* an emission's or ambient colour's shared vector of halves in every
+     * lane (halves_every_lane), once every lane is evaluated; else NULL */
+    const double *half;
+    const unsigned char *half_has;
 } colour_entry;
 
 
@@ -183,6 +193,8 @@ struct rs_worker {
     size_t cc_n;          /* entries used per table */
     double *cc_val;       /* [(kind * cc_n + entry) * n_lanes + lane] */
     unsigned *cc_stamp;   /* the same */
+    double *cc_half;      /* the same, of CC_EMISSION and CC_AMBIENT */
+    unsigned char *cc_half_has; /* the same */
     rs_work work;         /* what this worker has traced (rs_worker_work) */
 };
 
@@ -406,6 +418,8 @@ void rs_integrator_destroy(rs_integrator *it)
     rs_lane_classes_destroy(it->classes);
     free(it->lane_light);
     free(it->lane_background);
+    free(it->background_half);
+    free(it->background_has);
     free(it->lane_xyz);
     free(it);
 }
@@ -424,7 +438,10 @@ rs_worker *rs_worker_create(const rs_integrator *it)
         w->cc_n /= 2;
     w->cc_val = calloc((size_t)CC_KINDS * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_val);
     w->cc_stamp = calloc((size_t)CC_KINDS * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_stamp);
-    if (!w->lane_all || !w->lane_value || !w->lane_at || !w->cc_val || !w->cc_stamp) {
+    w->cc_half = calloc((size_t)CC_HALVES * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_half);
+    w->cc_half_has = calloc((size_t)CC_HALVES * w->cc_n * (size_t)it->n_lanes, 1);
+    if (!w->lane_all || !w->lane_value || !w->lane_at || !w->cc_val || !w->cc_stamp ||
+        !w->cc_half || !w->cc_half_has) {
         rs_worker_destroy(w);
         return NULL;
     }
@@ -483,6 +500,8 @@ void rs_worker_destroy(rs_worker *w)
     free(w->lane_at);
     free(w->cc_val);
     free(w->cc_stamp);
+    free(w->cc_half);
+    free(w->cc_half_has);
     free(w->pixel.r);
     free(w->pixel.lane);
     free(w->pixel.I);
@@ -563,7 +582,8 @@ static lp_ray *bundle_push(bundle *b, int lane)
  * caller sets every entry.  A shared vector's intensity is 0 in every
  * lane that does not have the ray, so that a lane's sum may add the whole
  * vector.  NULL when out of memory. */
-static lp_ray *bundle_push_shared(bundle *b, int nl, int clear, double **I, unsigned char **has)
+static inline lp_ray *bundle_push_shared(bundle *b, int nl, int clear, double **I,
+                                         unsigned char **has)
 {
     if (b->ns == b->scap) {
         size_t cap = b->scap ? 2 * b->scap : 8;
@@ -662,20 +682,44 @@ static double band_light_eval(const rs_integrator *it, const band *b, int k)
 }
 
 
+/* The shared vector of the halves of a source for every lane 0..nl-1: a
+ * lane that emits (lane_emits) has the ray with intensity 0.5 v[l], the
+ * others have +0.  Every lane in one pass, the lanes kept by a bit mask
+ * (no branch: it vectorizes). */
+RS_WIDE static void halves_every_lane(int nl, const double *restrict v,
+                                      const unsigned char *restrict got, double *restrict I,
+                                      unsigned char *restrict has)
+{
+    for (int l = 0; l < nl; l++) {
+        unsigned char keep = got ? got[l] != 0 : v[l] != 0.0;
+        double x = 0.5 * v[l];
+        uint64_t bits;
+        memcpy(&bits, &x, sizeof bits);
+        bits &= (uint64_t)0 - keep;
+        has[l] = keep;
+        memcpy(&I[l], &bits, sizeof bits);
+    }
+}
+
 /* The tables of light and background per lane (see struct rs_integrator). */
 static int make_lane_tables(rs_integrator *it)
 {
     size_t nl = it->scene->n_lights, n = (size_t)it->n_lanes;
     it->lane_light = calloc(nl * n + 1, sizeof *it->lane_light);
     it->lane_background = calloc(n + 1, sizeof *it->lane_background);
+    it->background_half = calloc(n + 1, sizeof *it->background_half);
+    it->background_has = calloc(n + 1, 1);
     it->lane_xyz = calloc(3 * n + 1, sizeof *it->lane_xyz);
-    if (!it->lane_light || !it->lane_background || !it->lane_xyz)
+    if (!it->lane_light || !it->lane_background || !it->background_half ||
+        !it->background_has || !it->lane_xyz)
         return -1;
     for (size_t k = 0; k < nl; k++)
         for (size_t i = 0; i < n; i++)
             it->lane_light[k * n + i] = band_light_eval(it, &it->lanes[i], (int)k);
     for (size_t i = 0; i < n; i++)
         it->lane_background[i] = band_emission(&it->lanes[i], it->scene->background);
+    halves_every_lane(it->n_lanes, it->lane_background, NULL, it->background_half,
+                      it->background_has);
     for (size_t i = 0; i < n && it->opts.mode != RS_MODE_RGB; i++) {
         const band *b = &it->lanes[i];
         if (b->kind == BAND_CONTINUUM) {
@@ -716,6 +760,9 @@ static const double *lane_colour_fill(rs_worker *w, int kind, size_t e, rs_color
     if (ce->gen == 0 || memcmp(&ce->c, &c, sizeof c) != 0) {
         ce->c = c;
         ce->n_valid = 0;
+        ce->dark = 0;
+        ce->half = NULL;
+        ce->half_has = NULL;
         if (++ce->gen == 0) { /* wrapped: no stamp may match a new generation */
             memset(stamp, 0, (size_t)it->n_lanes * sizeof *stamp);
             ce->gen = 1;
@@ -732,22 +779,44 @@ static const double *lane_colour_fill(rs_worker *w, int kind, size_t e, rs_color
         stamp[l] = ce->gen;
         ce->n_valid++;
     }
+    if (ce->n_valid == it->n_lanes) {
+        int dark = 1;
+        for (int l = 0; l < it->n_lanes; l++)
+            dark &= !(v[l] != 0.0);
+        ce->dark = dark;
+        if (kind < CC_HALVES) {
+            halves_every_lane(it->n_lanes, v, NULL, w->cc_half + at, w->cc_half_has + at);
+            ce->half = w->cc_half + at;
+            ce->half_has = w->cc_half_has + at;
+        }
+    }
     return v;
 }
 
 /* Colour c for use `kind` (see colour_entry) in lanes lane[0..n), at
  * [lane] of the array returned (the other lanes' values may be stale):
  * band_reflectance for the pigment and mirror colours, band_emission for
- * the others.  Valid until the next look-up of this kind.  Inline, the
- * look-up of a colour held in every lane already (the usual case). */
-static inline const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane,
-                                        int n)
+ * the others; its entry in *entry.  Valid until the next look-up of this
+ * kind.  Inline, the look-up of a colour held in every lane already (the
+ * usual case). */
+static inline const double *lane_colour_entry(rs_worker *w, int kind, rs_color c,
+                                              const int *lane, int n,
+                                              const colour_entry **entry)
 {
     size_t e = colour_slot(w, c);
     const colour_entry *ce = &w->cc[kind][e];
+    *entry = ce;
     if (ce->gen != 0 && ce->n_valid == w->it->n_lanes && memcmp(&ce->c, &c, sizeof c) == 0)
         return w->cc_val + ((size_t)kind * w->cc_n + e) * (size_t)w->it->n_lanes;
     return lane_colour_fill(w, kind, e, c, lane, n);
+}
+
+/* lane_colour_entry without the entry. */
+static inline const double *lane_colour(rs_worker *w, int kind, rs_color c, const int *lane,
+                                        int n)
+{
+    const colour_entry *ce;
+    return lane_colour_entry(w, kind, c, lane, n, &ce);
 }
 
 /* The parity (0 or 1) of floor(v + 1e-10) for any v: below 2^62 the
@@ -951,6 +1020,7 @@ typedef struct shade_point {
     /* per lane of the packet (lane_colour): valid until the worker shades
      * another point */
     const double *emission, *ambient, *pigment;
+    const colour_entry *emission_entry, *ambient_entry; /* their entries */
 } shade_point;
 
 static void shade_begin(rs_worker *w, const int *lane, int n, const rs_hit *h, lp_vec3 dir,
@@ -962,9 +1032,11 @@ static void shade_begin(rs_worker *w, const int *lane, int n, const rs_hit *h, l
     const rs_finish *f = &o->finish;
     sp->h = h;
     sp->pig = pigment_at(&o->pigment, h->point);
-    sp->emission = lane_colour(w, CC_EMISSION, mul(sp->pig, f->emission), lane, n);
-    sp->ambient = lane_colour(w, CC_AMBIENT,
-                              mul(sp->pig, mul(f->ambient, sc->settings.ambient_light)), lane, n);
+    sp->emission = lane_colour_entry(w, CC_EMISSION, mul(sp->pig, f->emission), lane, n,
+                                     &sp->emission_entry);
+    sp->ambient = lane_colour_entry(w, CC_AMBIENT,
+                                    mul(sp->pig, mul(f->ambient, sc->settings.ambient_light)),
+                                    lane, n, &sp->ambient_entry);
     sp->pigment = lane_colour(w, CC_PIGMENT, sp->pig, lane, n);
     sp->x = v3_madd(h->point, h->normal, 1e-9 * (1.0 + sqrt(v3_dot(h->point, h->point))));
     sp->cb = fr->cb;
@@ -1340,31 +1412,48 @@ static void emit_halves(void *ctx, int source, double radiance)
     }
 }
 
+/* Whether lane l emits in shared_halves: got[l] set (got NULL: v[l] != 0). */
+static inline int lane_emits(const double *v, const unsigned char *got, int l)
+{
+    return got ? got[l] != 0 : v[l] != 0.0;
+}
+
 /* The pair of shared halves (emit_halves for several lanes at once) of
  * one source for the lanes lane[0..n) that emit there: those with
  * got[l] set (got NULL: those with v[l] != 0), l = lane[k], radiance
- * v[l]; none when no lane emits.  Returns -1 when out of memory. */
+ * v[l]; none when no lane emits.  The vector of a packet of every lane
+ * (n == nl: its lanes are 0..nl-1 in some order) is half and half_has,
+ * halves_every_lane of v kept with it, where given (not NULL), else
+ * filled in a loop that vectorizes.  Returns -1 when out of memory. */
 static int shared_halves(int nl, const emit_ctx *e, int source, const int *lane, int n,
-                         const double *v, const unsigned char *got)
+                         const double *v, const unsigned char *got, const double *half,
+                         const unsigned char *half_has)
 {
     bundle *out = e->out;
     double *I;
     unsigned char *has;
-    int k = 0;
-    while (k < n && !(got ? got[lane[k]] : v[lane[k]] != 0.0))
+    int every = n == nl, k = 0;
+    while (k < n && !lane_emits(v, got, lane[k]))
         k++;
     if (k == n)
         return 0;
-    lp_ray *r = bundle_push_shared(out, nl, 1, &I, &has);
+    lp_ray *r = bundle_push_shared(out, nl, !every, &I, &has);
     if (!r)
         return -1;
     half_ray(e, source, 0, r);
     r->intensity = 0.5 * v[lane[k]];
-    for (; k < n; k++) {
-        int l = lane[k];
-        if (got ? got[l] : v[l] != 0.0) {
-            has[l] = 1;
-            I[l] = 0.5 * v[l];
+    if (every && half) {
+        memcpy(I, half, (size_t)nl * sizeof *I);
+        memcpy(has, half_has, (size_t)nl);
+    } else if (every) {
+        halves_every_lane(nl, v, got, I, has);
+    } else {
+        for (; k < n; k++) {
+            int l = lane[k];
+            if (lane_emits(v, got, l)) {
+                has[l] = 1;
+                I[l] = 0.5 * v[l];
+            }
         }
     }
     /* the other half: the same lanes and intensities, the same vector */
@@ -1386,8 +1475,13 @@ static int shade_packet(const rs_integrator *it, const int *lane, int n, shade_p
     const rs_scene *sc = it->scene;
     const rs_finish *f = &sp->h->surface->finish;
     int nl = it->n_lanes;
-    if (shared_halves(nl, e, source0, lane, n, sp->emission, NULL) != 0 ||
-        shared_halves(nl, e, 0, lane, n, sp->ambient, NULL) != 0)
+    /* a colour 0 in every lane emits in none */
+    if ((!sp->emission_entry->dark &&
+         shared_halves(nl, e, source0, lane, n, sp->emission, NULL, sp->emission_entry->half,
+                       sp->emission_entry->half_has) != 0) ||
+        (!sp->ambient_entry->dark &&
+         shared_halves(nl, e, 0, lane, n, sp->ambient, NULL, sp->ambient_entry->half,
+                       sp->ambient_entry->half_has) != 0))
         return -1;
     for (size_t q = 0; q < sc->n_lights; q++) {
         for (int k = 0; k < n; k++) {
@@ -1395,7 +1489,8 @@ static int shade_packet(const rs_integrator *it, const int *lane, int n, shade_p
             double rho = sp->pigment[l] * f->diffuse;
             fr->light_got[l] = lit(f, rho) && light_term(it, sp, rho, l, q, &fr->light_v[l]);
         }
-        if (shared_halves(nl, e, src_light(it, (int)q), lane, n, fr->light_v, fr->light_got) != 0)
+        if (shared_halves(nl, e, src_light(it, (int)q), lane, n, fr->light_v, fr->light_got,
+                          NULL, NULL) != 0)
             return -1;
     }
     return 0;
@@ -1557,9 +1652,10 @@ static int gather_groups(frame *fr, size_t j, int batch, size_t n_g)
  * quotient is exactly 1 in a lane whose input is I0 and the lane gets gI
  * itself.  Every lane in one pass, the lanes kept by a bit mask (no
  * branch: it vectorizes). */
-static void scale_lanes(int nl, const double *restrict cI, const unsigned char *restrict ch,
-                        const unsigned char *restrict bad, double I0, double gI,
-                        double *restrict Io, unsigned char *restrict has)
+RS_WIDE static void scale_lanes(int nl, const double *restrict cI,
+                                const unsigned char *restrict ch,
+                                const unsigned char *restrict bad, double I0, double gI,
+                                double *restrict Io, unsigned char *restrict has)
 {
     for (int k = 0; k < nl; k++) {
         double v = gI * (cI[k] / I0);
@@ -1570,6 +1666,17 @@ static void scale_lanes(int nl, const double *restrict cI, const unsigned char *
         has[k] = keep;
         memcpy(&Io[k], &bits, sizeof bits);
     }
+}
+
+/* scale_lanes where no lane failed and 0 < gI <= DBL_MAX: every lane's
+ * gI (cI[k] / I0) as it stands, has the ray's own (copied by the caller):
+ * a lane without the ray has cI[k] = +0 (bundle_push_shared), so it gets
+ * gI (+0 / I0) = +0 as scale_lanes gives it. */
+RS_WIDE static void scale_kept_lanes(int nl, const double *restrict cI, double I0, double gI,
+                                     double *restrict Io)
+{
+    for (int k = 0; k < nl; k++)
+        Io[k] = gI * (cI[k] / I0);
 }
 
 /* Gather the rays of fr->child (lanes of equal optics at this lens) along
@@ -1635,11 +1742,15 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
                 double *Io;
                 unsigned char *has;
                 int first;
-                lp_ray ray = *gr;
                 size_t s = (size_t)(-1 - c->lane[i]) * (size_t)nl;
                 if (!(r = bundle_push_shared(out, nl, 0, &Io, &has)))
                     return -1;
-                scale_lanes(nl, c->I + s, c->has + s, fr->bad, I0, gr->intensity, Io, has);
+                if (!any_bad && gr->intensity > 0.0 && gr->intensity <= DBL_MAX) {
+                    scale_kept_lanes(nl, c->I + s, I0, gr->intensity, Io);
+                    memcpy(has, c->has + s, (size_t)nl);
+                } else {
+                    scale_lanes(nl, c->I + s, c->has + s, fr->bad, I0, gr->intensity, Io, has);
+                }
                 for (first = 0; first < nl && !has[first]; first++)
                     ;
                 if (first == nl) { /* every lane failed: no ray */
@@ -1647,8 +1758,8 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
                     out->ns--;
                     break;
                 }
-                ray.intensity = Io[first];
-                *r = ray;
+                *r = *gr;
+                r->intensity = Io[first];
             }
             if (split)
                 r->ch = rs_coherence_split(r->ch, hit, q[j].depth, q[j].kind != LP_KIND_REFLECT);
@@ -1695,7 +1806,8 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
         if (e.wavelet < 0)
             return;
         if (n > 1) {
-            shared_halves(it->n_lanes, &e, 1, lane, n, L, NULL);
+            shared_halves(it->n_lanes, &e, 1, lane, n, L, NULL, it->background_half,
+                          it->background_has);
         } else {
             e.lane = lane[0];
             emit_halves(&e, 1, L[lane[0]]);
@@ -1790,7 +1902,7 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
 }
 
 /* L[k] += I[k] for every lane (vectorized). */
-static void add_lanes(int nl, const double *restrict I, double *restrict L)
+RS_WIDE static void add_lanes(int nl, const double *restrict I, double *restrict L)
 {
     for (int k = 0; k < nl; k++)
         L[k] += I[k];

@@ -1,0 +1,158 @@
+/* gather_lanes.c -- a polarized gather whose fields stay real, a few rays
+ * at a time in lanes.
+ *
+ * In the polarized mode a bundle ray's field is real until a node under
+ * total internal reflection (or at normal incidence, where the node's s
+ * axis follows the field) makes it complex; both are properties of the
+ * query's way, not of the ray (lp__backward_built marks the queries whose
+ * way is free of them).  Along such a way every ray of a gather takes the
+ * same steps: its field direction is checked and taken into the lens
+ * frame and scaled to its amplitude; at each node the field is projected
+ * on the node's s and p axes and rebuilt on the branch's axes (a
+ * reflection counting its phase jump), having lost power to the glass on
+ * the segment before; the field leaving is one linear ray.  The rays of
+ * a group take these steps side by side, in loops over lanes that the
+ * compiler vectorizes (lanes.h), each lane with the operations of the
+ * one-ray code (trace_backward.c: gather_one) in their order, so that its
+ * numbers are that code's bit for bit; the outgoing rays are then stored
+ * in the rays' order, as gathering them one by one stores them. */
+#include <math.h>
+
+#include "backward.h"
+#include "lanes.h"
+
+/* Rays per group. */
+#define GL 4
+
+/* A loop over the lanes of a group (lanes.h). */
+#define GL_LANES(i) LP__LANE_LOOP(i, GL)
+
+/* The lanes of a group. */
+typedef struct gl_lanes {
+    double vx[GL], vy[GL], vz[GL]; /* in: world field directions */
+    double in[GL];                 /* in: intensities */
+    double ok[GL];                 /* 1: the field direction checks out */
+    double ex[GL], ey[GL], ez[GL]; /* the field, local */
+    double ab[GL];                 /* power absorbed in the glass */
+    double fl[GL];                 /* phase jumps counted */
+    double pw[GL];                 /* out: the power leaving */
+    double wx[GL], wy[GL], wz[GL]; /* out: its world field direction */
+} gl_lanes;
+
+LP__WIDE static void gather_kernel(gl_lanes *restrict L, const lp_backward *bw, size_t q)
+{
+    const lp_lens *lens = bw->lens;
+    const lp_vec3 u = lens->u, v = lens->v, w = lens->w;
+    const lp_vec3 light = bw->entry[q].node.d, exit_d = bw->exit.d;
+    const int k = bw->query[q].depth, absorbs = bw->optics.alpha > 0.0;
+
+    /* lp__bundle_ray_check: the local field direction, perpendicular to
+     * the light; then the amplitude */
+    GL_LANES(i) {
+        lp_vec3 b = v3(L->vx[i], L->vy[i], L->vz[i]);
+        lp_vec3 l = v3(v3_dot(b, u), v3_dot(b, v), v3_dot(b, w));
+        double ok;
+        lp_vec3 e = v3_scale(lp__perp_unit_core(l, light, &ok), sqrt(L->in[i]));
+        L->ok[i] = ok;
+        L->ex[i] = e.x, L->ey[i] = e.y, L->ez[i] = e.z;
+        L->ab[i] = 0.0;
+        L->fl[i] = 0.0;
+    }
+    /* the way, in the light's direction: way_step_real */
+    for (int j = k; j >= 1; j--) {
+        const lp__bw_way *wj = j == k ? &bw->entry[q] : &bw->light[j];
+        const lp_vec3 s = wj->node.s, p = wj->node.p, ap = wj->ax.p;
+        if (j < k && absorbs) { /* over the segment from node j + 1 */
+            const double seg_abs = bw->node[j].seg_abs, seg_att = bw->node[j].seg_att;
+            GL_LANES(i) {
+                lp_vec3 e = v3(L->ex[i], L->ey[i], L->ez[i]);
+                L->ab[i] += v3_dot(e, e) * seg_abs;
+                e = v3_scale(e, seg_att);
+                L->ex[i] = e.x, L->ey[i] = e.y, L->ez[i] = e.z;
+            }
+        }
+        if (wj->reflect) { /* lp__node_reflect_real */
+            const double rs = creal(wj->node.f.rs), rp = creal(wj->node.f.rp);
+            GL_LANES(i) {
+                lp_vec3 e = v3(L->ex[i], L->ey[i], L->ez[i]);
+                double es = v3_dot(e, s), ep = v3_dot(e, p);
+                int flip = rs * (es * es) - rp * (ep * ep) < 0.0;
+                double a = flip ? -rs : rs, c = flip ? -rp : rp;
+                e = v3_add(v3_scale(s, a * es), v3_scale(ap, c * ep));
+                L->ex[i] = e.x, L->ey[i] = e.y, L->ez[i] = e.z;
+                L->fl[i] += flip ? 1.0 : 0.0;
+            }
+        } else { /* lp__node_transmit_real */
+            const double ts = wj->node.f.ts, tp = wj->node.f.tp;
+            GL_LANES(i) {
+                lp_vec3 e = v3(L->ex[i], L->ey[i], L->ez[i]);
+                double es = v3_dot(e, s), ep = v3_dot(e, p);
+                e = v3_add(v3_scale(s, ts * es), v3_scale(ap, tp * ep));
+                L->ex[i] = e.x, L->ey[i] = e.y, L->ez[i] = e.z;
+            }
+        }
+    }
+    /* lp__field_split_real and lp__emit_linear: the power and the world
+     * field direction of the ray leaving */
+    GL_LANES(i) {
+        lp_vec3 e = v3(L->ex[i], L->ey[i], L->ez[i]);
+        lp_vec3 d = lp__unit_perp(e, exit_d);
+        lp_vec3 o = v3_add(v3_add(v3_scale(u, d.x), v3_scale(v, d.y)), v3_scale(w, d.z));
+        L->pw[i] = v3_dot(e, e);
+        L->wx[i] = o.x, L->wy[i] = o.y, L->wz[i] = o.z;
+    }
+}
+
+/* Whether a bundle ray passes the checks of lp__bundle_ray_check that
+ * come before its field direction's. */
+static int ray_fine(const lp_ray *b)
+{
+    return isfinite(b->intensity) && !(b->intensity < 0.0) && isfinite(b->op) &&
+           isfinite(b->phase) && v3_finite(b->vp);
+}
+
+size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
+                        lp_result *res, lp_status *st, lp_error *err)
+{
+    const lp_query *qr = &bw->query[q];
+    gl_lanes L;
+    size_t done = 0;
+
+    *st = LP_OK;
+    while (done < n) {
+        size_t m = n - done < GL ? n - done : GL;
+        const lp_ray *b = bundle + done;
+        for (size_t i = 0; i < m; i++)
+            if (!ray_fine(&b[i])) {
+                m = i; /* ray i and the rest one by one: that reports ray i */
+                break;
+            }
+        if (m == 0)
+            return done;
+        for (size_t i = 0; i < GL; i++) { /* lanes past m repeat the first */
+            const lp_ray *r = &b[i < m ? i : 0];
+            L.vx[i] = r->vp.x, L.vy[i] = r->vp.y, L.vz[i] = r->vp.z;
+            L.in[i] = r->intensity;
+        }
+        gather_kernel(&L, bw, q);
+        for (size_t i = 0; i < m; i++) {
+            if (L.ok[i] == 0.0)
+                return done; /* the field direction fails: one by one */
+            lp__payload pl = {bw->optics.lambda_nm, b[i].kphi + (int)L.fl[i],
+                              b[i].op + qr->op, b[i].phase, b[i].ch};
+            double before = res->out;
+            res->in += L.in[i];
+            res->nodes += (size_t)qr->depth;
+            if (L.pw[i] > 0.0) { /* lp__field_split_real: one part */
+                *st = lp__emit_ray(res, &bw->exit, &pl, qr->depth, qr->kind, qr->surface,
+                                   qr->path, qr->waves, 0, L.pw[i],
+                                   v3(L.wx[i], L.wy[i], L.wz[i]), 0.0, err);
+                if (*st != LP_OK)
+                    return done;
+            }
+            lp__gathered_rest(res, before, L.in[i], L.ab[i]);
+            done++;
+        }
+    }
+    return done;
+}
