@@ -357,7 +357,9 @@ typedef struct lp_hit {
 /* Nearest intersection of the world ray origin + t*dir with the lens
  * surface, t in (t_min, t_max).  dir is normalized first, so t is a
  * distance in mm.  Returns 1 and fills *hit, or 0 when there is none or
- * the input is not finite. */
+ * the input is not finite.  A cap's edge circle belongs to the opaque
+ * rim: a ray through it (to within the lens's rounding, about 1e-12 of its
+ * size) meets the rim there, never a cap it would leave. */
 LP_API int lp_lens_intersect(const lp_lens *lens, lp_vec3 origin, lp_vec3 dir,
                              double t_min, double t_max, lp_hit *hit);
 

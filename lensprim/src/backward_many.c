@@ -312,7 +312,8 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
             live++;
             double t;
             lp_vec3 p = v3(W.px[k], W.py[k], W.pz[k]), dk = v3(W.dx[k], W.dy[k], W.dz[k]);
-            if (W.rim[k] != 0.0 && lp__rim_intersect(&K->r, p, dk, K->eps, W.t[k], &t)) {
+            if (W.rim[k] != 0.0 &&
+                lp__rim_intersect(&K->r, p, dk, K->eps, lp__rim_t_max(W.t[k], K->eps), &t)) {
                 W.t[k] = t;
                 W.hs[k] = LP_SURFACE_RIM;
                 lp_vec3 x = v3_madd(p, dk, t);

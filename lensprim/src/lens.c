@@ -242,7 +242,8 @@ int lp__lens_hit(const lp_lens *lens, lp_vec3 p, lp_vec3 d, int from_surface,
                              ? !(t_other >= 0.0 && lp__rim_beyond(rim, p, d))
                              : !(from_surface != LP_SURFACE_NONE && inside_rim(rim, p) &&
                                  inside_rim(rim, x)));
-    if (rim_possible && lp__rim_intersect(rim, p, d, t_other, best, &t)) {
+    double t_rim = surface == LP_SURFACE_NONE ? best : lp__rim_t_max(best, lens->eps);
+    if (rim_possible && lp__rim_intersect(rim, p, d, t_other, t_rim, &t)) {
         best = t;
         surface = LP_SURFACE_RIM;
         x = v3_madd(p, d, best);

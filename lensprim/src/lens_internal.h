@@ -73,6 +73,17 @@ int lp__rim_intersect(const lp__rim *rim, lp_vec3 p, lp_vec3 d, double t_min,
                       double t_max, double *t);
 lp_vec3 lp__rim_normal(const lp__rim *rim, lp_vec3 p);
 
+/* The t_max of the rim's test after a cap's hit at t_cap: a rim hit up to
+ * eps beyond it takes the cap's place.  Both meet at the cap's edge
+ * circle, where rounding puts either root first; the edge belongs to the
+ * opaque rim, so that a ray from outside never "leaves" the glass through
+ * a cap there, nor one from inside enters it.  (No cap hit: t_cap is the
+ * caller's bound, or +inf in the lanes, and stays so.) */
+static inline double lp__rim_t_max(double t_cap, double eps)
+{
+    return t_cap + eps;
+}
+
 /* Whether lp__rim_intersect(rim, p, d, t_min, ...) with t_min >= 0
  * certainly finds nothing because p lies beyond the rim's z range and d
  * leads away from it: a root's z = p.z + s d.z with s > 0 stays on p's

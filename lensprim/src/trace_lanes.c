@@ -412,7 +412,8 @@ static size_t between(lp__lanes *restrict L, const consts *K, int absorbs)
             continue;
         lp_vec3 p = v3(L->px[c], L->py[c], L->pz[c]);
         lp_vec3 d = v3(L->dx[c], L->dy[c], L->dz[c]);
-        if (lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, L->t[c], &t)) {
+        double t_max = lp__rim_t_max(L->t[c], K->lens.eps);
+        if (lp__rim_intersect(&K->lens.r, p, d, K->lens.eps, t_max, &t)) {
             lp_vec3 x = v3_madd(p, d, t);
             L->t[c] = t;
             L->hs[c] = 2.0;
@@ -445,7 +446,7 @@ static void entry_rim(lp__lanes *restrict L, const consts *K, const lp__lane_in 
         lp_vec3 p = v3(in->px[j], in->py[j], in->pz[j]);
         lp_vec3 d = v3(in->dx[j], in->dy[j], in->dz[j]);
         double t;
-        if (lp__rim_intersect(&K->lens.r, p, d, 0.0, L->t[j], &t))
+        if (lp__rim_intersect(&K->lens.r, p, d, 0.0, lp__rim_t_max(L->t[j], K->lens.eps), &t))
             L->hs[j] = RAY_RIM;
     }
 }

@@ -8,11 +8,12 @@
  *            filter and min_weight: random rays -- hits, rays grazing the
  *            lens's bounding sphere, rays from the far side, rays starting
  *            on the lens (its own outgoing rays fed back), rays that meet
- *            the rim, steep rays whose fields turn elliptical by total
- *            internal reflection and go on, rays along the axis (normal
- *            incidence), zero intensities, phases far outside [-pi, pi],
- *            all shuffled so that every group of the lane engine mixes
- *            them -- are traced by the batch and by lp_trace_forward_many
+ *            the rim, rays through a cap's exact edge circle (where the
+ *            cap's hit and the rim's tie), steep rays whose fields turn
+ *            elliptical by total internal reflection and go on, rays
+ *            along the axis (normal incidence), zero intensities, phases
+ *            far outside [-pi, pi], all shuffled so that every group of
+ *            the lane engine mixes them -- are traced by the batch and by lp_trace_forward_many
  *            on the same rays as lp_ray records, and by lp_trace_forward
  *            one ray at a time; so are groups of 1 to 200 rays from
  *            anywhere in them.  Every outgoing ray, every offset and every
@@ -174,7 +175,7 @@ static void make_rays(rays *r, const lp_lens *lens, lp_vec3 pos, lp_vec3 u, lp_v
 }
 
 static int n_identity_cases;
-static size_t n_identity_rays, n_two_parts, n_normal, n_on_lens;
+static size_t n_identity_rays, n_two_parts, n_normal, n_on_lens, n_edge;
 
 /* Rays first .. first+n of r, traced by the batch at lambda_nm, by
  * lp_trace_forward_many (the same rays as records) and one by one by
@@ -271,6 +272,25 @@ static void make_lane_rays(rays *r, const lp_lens *lens, lp_vec3 pos, lp_vec3 u,
         lp_vec3 d = i % 4 < 2 ? w : vec(-w.x, -w.y, -w.z);
         n_normal += off == 0.0;
         add_ray(r, o, d, v, 1.0);
+    }
+    /* at the caps' edge circles, where a cap's hit and the rim's tie */
+    lp_lens_desc ds;
+    lp_lens_get_desc(lens, &ds);
+    for (int i = 0; i < 64; i++) {
+        int back = i & 1;
+        double R = back ? ds.radius2 : ds.radius1;
+        double a = 0.5 * (back && ds.diameter2 > 0.0 ? ds.diameter2 : ds.diameter);
+        double sag = R == 0.0 || isinf(R) ? 0.0 : R - copysign(sqrt(R * R - a * a), R);
+        double phi = 2.0 * PI * uniform();
+        double z = (back ? ds.thickness : 0.0) + sag;
+        lp_vec3 e = place(pos, u, v, w, a * cos(phi), a * sin(phi), z);
+        double cz = 2.0 * uniform() - 1.0, az = 2.0 * PI * uniform(), sz = sqrt(1.0 - cz * cz);
+        lp_vec3 d = vec(sz * cos(az), sz * sin(az), cz);
+        double far = 3.0 * (h + t);
+        lp_vec3 o = vec(e.x - far * d.x, e.y - far * d.y, e.z - far * d.z);
+        lp_vec3 vp = fabs(d.x) < 0.9 ? vec(0.0, -d.z, d.y) : vec(-d.z, 0.0, d.x); /* d x axis */
+        add_ray(r, o, d, vp, 1.0);
+        n_edge++;
     }
     /* the lens's own outgoing rays of depth 1 and 2, fed back */
     n_on_lens += feed_back(r, lens, 7, 2);
@@ -397,8 +417,9 @@ static void test_identity(void)
     }
     printf("identity: %d cases (lens x mode x depth x args; whole sets, groups of 1 to 200), "
            "%zu rays, every ray, offset and sum identical; among them %zu along a lens's axis, "
-           "%zu starting on a lens; %zu second parts of elliptical fields out\n",
-           n_identity_cases, n_identity_rays, n_normal, n_on_lens, n_two_parts);
+           "%zu starting on a lens, %zu through a cap's edge circle; %zu second parts of "
+           "elliptical fields out\n",
+           n_identity_cases, n_identity_rays, n_normal, n_on_lens, n_edge, n_two_parts);
 }
 
 static void test_closed_form(void)

@@ -8,8 +8,8 @@
  * power (1 - R) I (Fresnel computed here) and lp_backward_rim_depth = 2;
  * on random lenses lp_backward_rim_depth equals the depth at which the
  * reference chain (traced here in ref_real) meets the rim; rays
- * through the exact cap/rim edge circle give finite results and a
- * balanced bookkeeping.
+ * through the exact cap/rim edge circle give finite results, a first hit
+ * that enters the glass or is on the rim, and a balanced bookkeeping.
  */
 #include <float.h>
 #include <math.h>
@@ -418,10 +418,22 @@ static void test_edge_circle(void)
             snprintf(ctx, sizeof ctx, "[edge circle: shape %zu ray %d]", si, k);
             lp_hit h;
             memset(&h, 0, sizeof h);
-            if (lp_lens_intersect(lens, Ow, dw, 0.0, INFINITY, &h))
+            if (lp_lens_intersect(lens, Ow, dw, 0.0, INFINITY, &h)) {
                 CHECK(isfinite(h.t) && vfinite(h.point) && vfinite(h.normal) &&
                           fabs(vlen(h.normal) - 1) < 1e-9,
                       "%s: non-finite hit", ctx);
+                /* The ray starts outside, so its first hit enters the
+                 * glass or is on the opaque rim: a cap that it would
+                 * leave there is not the first thing it meets (the edge
+                 * circle belongs to the rim).  A knife edge (edge
+                 * thickness 0, no rim) is left out: there the two caps
+                 * tie and either may come first. */
+                double dn = dw.x * h.normal.x + dw.y * h.normal.y + dw.z * h.normal.z;
+                if (lp_lens_edge_thickness(lens) > 0.0)
+                    CHECK(h.surface == LP_SURFACE_RIM || dn <= 0.0,
+                          "%s: first hit on cap %d leaves the glass (d.n = %.3g)", ctx, h.surface,
+                          dn);
+            }
             lp_ray in;
             ray_init(&in, Ow, dw, 1.0);
             lp_trace_args args;
