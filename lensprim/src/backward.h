@@ -52,6 +52,9 @@ struct lp_backward {
      * reflection or at normal incidence (its fields stay real: a gather
      * may take its rays in lanes, lp__gather_lanes) */
     unsigned char real_way[LP_MAX_DEPTH];
+    /* lp_backward_build_many's mark: whether this builder was met
+     * already in its list (found in two passes, not by comparing pairs) */
+    unsigned char listed;
 };
 
 /* Add the query of the given depth, kind and surface leaving node

@@ -392,9 +392,19 @@ lp_status lp_backward_build_many(lp_backward *const *bw, size_t n, const lp_lens
                      !v3_finite(origin) || !v3_finite(dir);
     lp_vec3 dw = v3_normalize(dir);
     one_by_one |= dw.x == 0.0 && dw.y == 0.0 && dw.z == 0.0;
-    for (size_t k = 0; k < n && !one_by_one; k++)
-        for (size_t i = 0; i <= k && !one_by_one; i++)
-            one_by_one = !bw[k] || (i < k && bw[i] == bw[k]); /* NULL or twice */
+    /* a NULL builder, or one twice: clear every mark, then set each,
+     * finding one set already (linear: a spectral renderer's packet has
+     * hundreds of wavelengths, and a test of every pair cost it more than
+     * the builds at 256 and more) */
+    for (size_t k = 0; k < n && !one_by_one; k++) {
+        one_by_one = !bw[k];
+        if (!one_by_one)
+            bw[k]->listed = 0;
+    }
+    for (size_t k = 0; k < n && !one_by_one; k++) {
+        one_by_one = bw[k]->listed;
+        bw[k]->listed = 1;
+    }
     size_t ok = 0; /* the wavelengths before the first that fails */
     if (!one_by_one) {
         /* every builder as lp_backward_build sets it before its chain */
