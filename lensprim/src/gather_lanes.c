@@ -15,7 +15,8 @@
  * amplitudes (s, p) are multiplied by the complex factors part by part,
  * as the compiler's complex product does.  A field that stays real
  * leaves as one linear ray; a complex one is split into the axes of its
- * ellipse by the one-ray code.  The rays of a group take these steps side
+ * ellipse, in lanes but for the ellipse's phase and its exponential
+ * (lp__ellipse_psi, lp__phasor_minus), taken lane by lane.  The rays of a group take these steps side
  * by side, in loops over lanes that the compiler vectorizes (lanes.h),
  * each lane with the operations of the one-ray code (trace_backward.c:
  * gather_one, interface.c: reflect_on, transmit_on; cvec3.h) in their
@@ -47,6 +48,13 @@ typedef struct gl_lanes {
     double fl[GL];                 /* phase jumps counted */
     double pw[GL];                 /* out: the power leaving */
     double wx[GL], wy[GL], wz[GL]; /* out: its world field direction */
+    /* a complex field's split (lp__field_split_elliptic): the square
+     * E.E, the ellipse's phase psi and exp(-i psi); out: the parts (0, 1
+     * or 2), the second one's power and world field direction */
+    double qr[GL], qi[GL], psi[GL], hr[GL], hi[GL];
+    double np[GL];
+    double pw1[GL];
+    double wx1[GL], wy1[GL], wz1[GL];
 } gl_lanes;
 
 /* lp__node_project of lane i's field on the axes s, p: the real and
@@ -78,6 +86,59 @@ LP__INLINE void gl_combine(gl_lanes *restrict L, int i, double ar, double ai, lp
     L->ez[i] = ar * s.z + br * pr.z, L->fz[i] = ai * s.z + bi * pr.z;
 }
 
+/* The world direction of the unit part of the local e perpendicular to
+ * the unit d (lp__unit_perp, lp__to_world_dir). */
+LP__INLINE lp_vec3 gl_world_perp(lp_vec3 e, lp_vec3 d, lp_vec3 u, lp_vec3 v, lp_vec3 w)
+{
+    lp_vec3 c = lp__unit_perp(e, d);
+    return v3_add(v3_add(v3_scale(u, c.x), v3_scale(v, c.y)), v3_scale(w, c.z));
+}
+
+/* lp__field_split of each lane's complex field, leaving along the local
+ * d, the lanes' outgoing parts in world directions (axes u, v, w), the
+ * first one's in pw and wx..wz: lp__field_split_elliptic's steps, the
+ * complex products part by part; the phase psi and exp(-i psi) by its
+ * own helpers, lane by lane (only the m lanes in use).  A field whose
+ * imaginary part is zero is marked odd (split as real by the one-ray
+ * code). */
+LP__INLINE void gl_split(gl_lanes *restrict L, int m, lp_vec3 d, lp_vec3 u, lp_vec3 v,
+                         lp_vec3 w)
+{
+    GL_LANES(i) { /* cv3_norm2, cv3_is_real, E.E */
+        double ex = L->ex[i], ey = L->ey[i], ez = L->ez[i];
+        double fx = L->fx[i], fy = L->fy[i], fz = L->fz[i];
+        L->pw[i] = ex * ex + fx * fx + ey * ey + fy * fy + ez * ez + fz * fz;
+        L->odd[i] += (fx == 0.0) & (fy == 0.0) & (fz == 0.0) ? 1.0 : 0.0;
+        L->qr[i] = (ex * ex - fx * fx) + (ey * ey - fy * fy) + (ez * ez - fz * fz);
+        L->qi[i] = (ex * fx + fx * ex) + (ey * fy + fy * ey) + (ez * fz + fz * ez);
+    }
+    for (int i = m; i < GL; i++) /* lanes not in use: psi 0 */
+        L->psi[i] = 0.0, L->hr[i] = 1.0, L->hi[i] = 0.0;
+    for (int i = 0; i < m; i++) {
+        double psi = lp__ellipse_psi(CMPLX(L->qr[i], L->qi[i]));
+        double complex h = psi == 0.0 ? 1.0 : lp__phasor_minus(psi);
+        L->psi[i] = psi, L->hr[i] = creal(h), L->hi[i] = cimag(h);
+    }
+    GL_LANES(i) { /* F = E exp(-i psi) (E itself for psi 0), A and B its parts */
+        double ex = L->ex[i], ey = L->ey[i], ez = L->ez[i];
+        double fx = L->fx[i], fy = L->fy[i], fz = L->fz[i];
+        double hr = L->hr[i], hi = L->hi[i], total = L->pw[i];
+        int same = L->psi[i] == 0.0;
+        lp_vec3 a = v3(same ? ex : ex * hr - fx * hi, same ? ey : ey * hr - fy * hi,
+                       same ? ez : ez * hr - fz * hi);
+        lp_vec3 b = v3(same ? fx : ex * hi + fx * hr, same ? fy : ey * hi + fy * hr,
+                       same ? fz : ez * hi + fz * hr);
+        double ia = v3_dot(a, a), ib = v3_dot(b, b);
+        int one = ib <= 1e-20 * total;
+        lp_vec3 o = gl_world_perp(a, d, u, v, w), o1 = gl_world_perp(b, d, u, v, w);
+        L->np[i] = !(total > 0.0) ? 0.0 : (one ? 1.0 : 2.0);
+        L->pw[i] = one ? total : ia;
+        L->wx[i] = o.x, L->wy[i] = o.y, L->wz[i] = o.z;
+        L->pw1[i] = ib;
+        L->wx1[i] = o1.x, L->wy1[i] = o1.y, L->wz1[i] = o1.z;
+    }
+}
+
 /* reflect_on for lane i's field (cplx: complex, else real at a node
  * under total internal reflection) and the complex rs, rp (real and
  * imaginary parts): the field turns the mirror way round where its
@@ -96,7 +157,7 @@ LP__INLINE void gl_reflect(gl_lanes *restrict L, int i, lp_vec3 s, lp_vec3 p, lp
     L->fl[i] += flip ? 1.0 : 0.0;
 }
 
-LP__WIDE static void gather_kernel(gl_lanes *restrict L, const lp_backward *bw, size_t q)
+LP__WIDE static void gather_kernel(gl_lanes *restrict L, const lp_backward *bw, size_t q, int m)
 {
     const lp_lens *lens = bw->lens;
     const lp_vec3 u = lens->u, v = lens->v, w = lens->w;
@@ -178,8 +239,10 @@ LP__WIDE static void gather_kernel(gl_lanes *restrict L, const lp_backward *bw, 
             }
         }
     }
-    if (jc > 0)
-        return; /* a complex field: split one by one */
+    if (jc > 0) {
+        gl_split(L, m, exit_d, u, v, w);
+        return;
+    }
     /* lp__field_split_real and lp__emit_linear: the power and the world
      * field direction of the ray leaving */
     GL_LANES(i) {
@@ -222,7 +285,7 @@ size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, s
             L.vx[i] = r->vp.x, L.vy[i] = r->vp.y, L.vz[i] = r->vp.z;
             L.in[i] = r->intensity;
         }
-        gather_kernel(&L, bw, q);
+        gather_kernel(&L, bw, q, (int)m);
         for (size_t i = 0; i < m; i++) {
             if (L.ok[i] == 0.0 || L.odd[i] != 0.0)
                 return done; /* the field direction fails, or turns real: one by one */
@@ -231,13 +294,17 @@ size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, s
             double before = res->out;
             res->in += L.in[i];
             res->nodes += (size_t)qr->depth;
-            if (bw->complex_at[q] > 0) { /* lp__emit_gathered of the complex field */
-                lp__cvec3 E = {CMPLX(L.ex[i], L.fx[i]), CMPLX(L.ey[i], L.fy[i]),
-                               CMPLX(L.ez[i], L.fz[i])};
-                *st = lp__emit_gathered(bw->lens, res, &E, &bw->exit, &pl, qr, L.in[i],
-                                        L.ab[i], err);
-                if (*st != LP_OK)
-                    return done;
+            if (bw->complex_at[q] > 0) { /* lp__emit_gathered_parts of the split */
+                for (int t = 0; t < (int)L.np[i]; t++) {
+                    *st = lp__emit_ray(res, &bw->exit, &pl, qr->depth, qr->kind, qr->surface,
+                                       qr->path, qr->waves, t, t ? L.pw1[i] : L.pw[i],
+                                       t ? v3(L.wx1[i], L.wy1[i], L.wz1[i])
+                                         : v3(L.wx[i], L.wy[i], L.wz[i]),
+                                       t ? L.psi[i] + 0.5 * LP_PI : L.psi[i], err);
+                    if (*st != LP_OK)
+                        return done;
+                }
+                lp__gathered_rest(res, before, L.in[i], L.ab[i]);
                 done++;
                 continue;
             }
