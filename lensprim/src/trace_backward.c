@@ -127,17 +127,24 @@ void lp__backward_built(lp_backward *bw)
         if (bw->query[qi].depth > deepest)
             deepest = bw->query[qi].depth;
     lp__backward_ways(bw, deepest);
-    /* where each way's fields turn complex, if the lanes take it */
+    /* where each way's fields turn complex, if the lanes take it: at[j]
+     * for the light's way from node j - 1 down (-1: not in lanes; 0: the
+     * field stays real; else the first node under total internal
+     * reflection), then each query's from its entry on */
+    signed char at[LP_MAX_DEPTH + 1];
+    at[1] = 0;
+    for (int j = 1; j < deepest; j++) {
+        const lp__bw_way *w = &bw->light[j];
+        int tir = w->node.f.tir;
+        at[j + 1] = (signed char)(w->node.normal || (tir && !w->reflect) || at[j] < 0 ? -1
+                                  : tir ? j : at[j]);
+    }
     for (size_t qi = 0; qi < bw->n_queries; qi++) {
-        int k = bw->query[qi].depth, at = 0;
-        for (int j = k; j >= 1 && at >= 0; j--) {
-            const lp__bw_way *w = j == k ? &bw->entry[qi] : &bw->light[j];
-            if (w->node.normal || (w->node.f.tir && !w->reflect))
-                at = -1;
-            else if (w->node.f.tir && at == 0)
-                at = j;
-        }
-        bw->complex_at[qi] = (signed char)at;
+        const lp__bw_way *w = &bw->entry[qi];
+        int k = bw->query[qi].depth, tir = w->node.f.tir;
+        bw->complex_at[qi] = (signed char)(w->node.normal || (tir && !w->reflect) || at[k] < 0
+                                               ? -1
+                                               : tir ? k : at[k]);
     }
     bw->ways = 1;
 }
