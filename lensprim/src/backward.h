@@ -48,10 +48,14 @@ struct lp_backward {
     int ways;
     lp__bw_way light[LP_MAX_DEPTH]; /* light[j]: node j, light arriving from inside */
     lp__bw_way entry[LP_MAX_DEPTH]; /* entry[q]: where query q's light enters */
-    /* per query: 1 when no node of its way is under total internal
-     * reflection or at normal incidence (its fields stay real: a gather
-     * may take its rays in lanes, lp__gather_lanes) */
-    unsigned char real_way[LP_MAX_DEPTH];
+    /* per query, how a gather may take its rays in lanes
+     * (lp__gather_lanes): 0 when its fields stay real (no node of its way
+     * under total internal reflection or at normal incidence); j >= 1
+     * when they turn complex at node j, the first under total internal
+     * reflection the light meets, and the way has no node at normal
+     * incidence nor a total internal reflection where the light
+     * refracts; -1 otherwise (one ray at a time) */
+    signed char complex_at[LP_MAX_DEPTH];
     /* lp_backward_build_many's mark: whether this builder was met
      * already in its list (found in two passes, not by comparing pairs) */
     unsigned char listed;
@@ -82,13 +86,14 @@ void lp__backward_built(lp_backward *bw);
 void lp__backward_entry_way(const lp_backward *bw, size_t qi, lp__bw_way *w);
 void lp__backward_light_way(const lp_backward *bw, int j, lp__bw_way *w);
 
-/* Gather bundle[0..n) along query q, whose way keeps fields real
- * (bw->real_way[q]), into res as gathering them one by one does, the same
- * bits, a few rays at a time in lanes (gather_lanes.c).  Returns how many
- * rays it gathered, in order: n, or fewer where a ray fails its checks
- * (the caller gathers it and the rest one by one, which reports it) or
- * where an outgoing ray cannot be stored (*st LP_ERROR_NO_MEMORY, with
- * err; else *st is LP_OK). */
+/* Gather bundle[0..n) along query q, whose way the lanes take
+ * (bw->complex_at[q] >= 0), into res as gathering them one by one does,
+ * the same bits, a few rays at a time in lanes (gather_lanes.c).  Returns
+ * how many rays it gathered, in order: n, or fewer where a ray fails its
+ * checks (the caller gathers it and the rest one by one, which reports
+ * it) or whose complex field turns real again on the way (left to the
+ * one-ray code too), or where an outgoing ray cannot be stored (*st
+ * LP_ERROR_NO_MEMORY, with err; else *st is LP_OK). */
 size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
                         lp_result *res, lp_status *st, lp_error *err);
 

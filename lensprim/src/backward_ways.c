@@ -164,7 +164,9 @@ void lp__backward_ways(lp_backward *bw, int deepest)
     wl_lanes L;
     for (size_t k0 = 0; k0 < n; k0 += WL) {
         int m = n - k0 < WL ? (int)(n - k0) : WL;
-        for (int i = 0; i < WL; i++) /* lanes past m repeat the first */
+        /* lanes past m repeat the first in a first group, and keep the
+         * last group's ways (set up for nothing) after it */
+        for (int i = 0; i < (k0 == 0 ? WL : m); i++)
             lane_in(bw, k0 + (size_t)(i < m ? i : 0), &L, i);
         ways_kernel(&L);
         for (int i = 0; i < m; i++)

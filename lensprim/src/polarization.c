@@ -4,30 +4,16 @@
  * bilinear square E.E = exp(2 i psi)(|A|^2 - |B|^2) fixes psi, and A, B
  * are the real and imaginary parts of E exp(-i psi).  A linear field is
  * real up to a common phase, so B vanishes and one ray carries it. */
-#include <float.h>
 #include <math.h>
 
 #include "polarization.h"
-
-/* exp(-i psi), exactly as cexp(-I * psi) gives it, without the general
- * complex exponential for a finite psi: exp(-0 or +0) = 1 times the
- * cosine and sine of -psi (sine -psi and cosine 1 for |psi| <= DBL_MIN). */
-static inline double complex phasor_minus(double psi)
-{
-    double t = -psi;
-    if (fabs(t) > DBL_MIN && fabs(t) <= DBL_MAX)
-        return CMPLX(cos(t), sin(t));
-    if (fabs(t) <= DBL_MIN)
-        return CMPLX(1.0, t);
-    return cexp(-I * psi);
-}
 
 int lp__field_split_elliptic(const lp__cvec3 *E, double total, lp_vec3 dir,
                              lp__linear_part part[2])
 {
     double complex q = E->x * E->x + E->y * E->y + E->z * E->z;
-    double psi = (cimag(q) == 0.0 && creal(q) >= 0.0) ? 0.0 : 0.5 * carg(q);
-    lp__cvec3 F = psi == 0.0 ? *E : cv3_scale(*E, phasor_minus(psi));
+    double psi = lp__ellipse_psi(q);
+    lp__cvec3 F = psi == 0.0 ? *E : cv3_scale(*E, lp__phasor_minus(psi));
     lp_vec3 a = cv3_re(F), b = cv3_im(F);
     double ia = v3_dot(a, a), ib = v3_dot(b, b);
 

@@ -16,6 +16,26 @@ static inline lp_vec3 lp__unit_perp(lp_vec3 v, lp_vec3 dir)
     return v3_normalize(v3_sub(v, v3_scale(dir, v3_dot(v, dir))));
 }
 
+/* The phase psi of the ellipse of a field whose bilinear square E.E is
+ * q: arg(q)/2, and 0 for a q real and not negative (lp__field_split). */
+static inline double lp__ellipse_psi(double complex q)
+{
+    return (cimag(q) == 0.0 && creal(q) >= 0.0) ? 0.0 : 0.5 * carg(q);
+}
+
+/* exp(-i psi), exactly as cexp(-I * psi) gives it, without the general
+ * complex exponential for a finite psi: exp(-0 or +0) = 1 times the
+ * cosine and sine of -psi (sine -psi and cosine 1 for |psi| <= DBL_MIN). */
+static inline double complex lp__phasor_minus(double psi)
+{
+    double t = -psi;
+    if (fabs(t) > DBL_MIN && fabs(t) <= DBL_MAX)
+        return CMPLX(cos(t), sin(t));
+    if (fabs(t) <= DBL_MIN)
+        return CMPLX(1.0, t);
+    return cexp(-I * psi);
+}
+
 /* The split of a field with an imaginary part and power total > 0. */
 int lp__field_split_elliptic(const lp__cvec3 *E, double total, lp_vec3 dir,
                              lp__linear_part part[2]);

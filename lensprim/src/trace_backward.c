@@ -127,14 +127,24 @@ void lp__backward_built(lp_backward *bw)
         if (bw->query[qi].depth > deepest)
             deepest = bw->query[qi].depth;
     lp__backward_ways(bw, deepest);
-    /* the ways that keep a field real: up to node j - 1 (real[j]) */
-    unsigned char real[LP_MAX_DEPTH + 1];
-    real[1] = 1;
-    for (int j = 1; j < deepest; j++)
-        real[j + 1] = real[j] && !bw->light[j].node.normal && !bw->light[j].node.f.tir;
+    /* where each way's fields turn complex, if the lanes take it: at[j]
+     * for the light's way from node j - 1 down (-1: not in lanes; 0: the
+     * field stays real; else the first node under total internal
+     * reflection), then each query's from its entry on */
+    signed char at[LP_MAX_DEPTH + 1];
+    at[1] = 0;
+    for (int j = 1; j < deepest; j++) {
+        const lp__bw_way *w = &bw->light[j];
+        int tir = w->node.f.tir;
+        at[j + 1] = (signed char)(w->node.normal || (tir && !w->reflect) || at[j] < 0 ? -1
+                                  : tir ? j : at[j]);
+    }
     for (size_t qi = 0; qi < bw->n_queries; qi++) {
-        const lp__node *nd = &bw->entry[qi].node;
-        bw->real_way[qi] = real[bw->query[qi].depth] && !nd->normal && !nd->f.tir;
+        const lp__bw_way *w = &bw->entry[qi];
+        int k = bw->query[qi].depth, tir = w->node.f.tir;
+        bw->complex_at[qi] = (signed char)(w->node.normal || (tir && !w->reflect) || at[k] < 0
+                                               ? -1
+                                               : tir ? k : at[k]);
     }
     bw->ways = 1;
 }
@@ -414,7 +424,7 @@ lp_status lp_backward_gather(const lp_backward *bw, size_t q, const lp_ray *bund
             light = way;
         }
         size_t i = 0;
-        if (bw->ways && bw->real_way[q]) {
+        if (bw->ways && bw->complex_at[q] >= 0) {
             i = lp__gather_lanes(bw, q, bundle, n, out, &st, err);
             if (st != LP_OK)
                 return st;
