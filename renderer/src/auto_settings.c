@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bvh.h"
 #include "camera.h"
 #include "shapes.h"
 
@@ -157,6 +158,47 @@ static int sees_lens(const rs_scene *s, lp_vec3 o, lp_vec3 d)
         t = h.t;
         skip = h.object;
     }
+    return 0;
+}
+
+/* The lenses' boxes, which a camera ray must meet to see a lens (a hit an
+ * object reports lies in its box): testing them first spares the scene
+ * intersections of the pixels that cannot see one, most of the image,
+ * and changes no pixel's answer.  boxed 0: some lens has no box (or the
+ * scene no tree), so every pixel is intersected. */
+typedef struct lens_boxes {
+    int *lens; /* the lenses' object indices */
+    size_t n;
+    int boxed;
+} lens_boxes;
+
+static int lens_boxes_init(const rs_scene *s, lens_boxes *lb)
+{
+    lb->n = 0;
+    lb->boxed = s->bvh && rs_bvh_object_count(s->bvh) == s->n_objects;
+    lb->lens = malloc(sizeof *lb->lens * (s->n_objects + 1));
+    if (!lb->lens)
+        return -1;
+    for (size_t i = 0; i < s->n_objects; i++) {
+        if (s->objects[i].type != RS_OBJ_LENS)
+            continue;
+        lb->lens[lb->n++] = (int)i;
+        if (!rs_bvh_culls(s->bvh, (int)i))
+            lb->boxed = 0;
+    }
+    return 0;
+}
+
+/* Might the camera ray (o, d) meet a lens?  0 only when it cannot. */
+static int may_see_lens(const rs_scene *s, const lens_boxes *lb, lp_vec3 o, lp_vec3 d)
+{
+    rs_slab_ray r;
+    if (!lb->boxed)
+        return 1;
+    rs_slab_ray_init(&r, o, d);
+    for (size_t k = 0; k < lb->n; k++)
+        if (rs_bvh_may_meet(s->bvh, lb->lens[k], &r, 0.0, INFINITY))
+            return 1;
     return 0;
 }
 
@@ -311,15 +353,18 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
         return -1;
     unsigned char *group = malloc((size_t)total);
     unsigned char *mark = calloc((size_t)total, 1);
-    if (!group || !mark) {
+    lens_boxes lb = {NULL, 0, 0};
+    if (!group || !mark || lens_boxes_init(s, &lb) != 0) {
         free(group);
         free(mark);
+        free(lb.lens);
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
     if (pilot_mark(s, base, polarized, step, mark, spent, msg, msg_size) != 0) {
         free(group);
         free(mark);
+        free(lb.lens);
         return -1;
     }
     for (int j = 0; j < height; j++)
@@ -327,12 +372,13 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
             lp_vec3 o, d;
             long k = (long)j * width + i;
             rs_camera_ray(&view, i + 0.5, j + 0.5, width, height, &o, &d);
-            int lens = sees_lens(s, o, d);
+            int lens = may_see_lens(s, &lb, o, d) && sees_lens(s, o, d);
             int g = mark[k] ? G_MARKED : lens ? G_LENS : G_OTHER;
             group[k] = (unsigned char)g;
             count[g]++;
             ps->lens_share += lens ? 1.0 / (double)total : 0.0;
         }
+    free(lb.lens);
     /* A marked pixel (cell_pixel) stands for its pilot cell (at most what
      * there is); the other groups share the rest in proportion. */
     {
