@@ -737,7 +737,10 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         rs_render_opts f = o;
         f.depth = tr[t_lad].depth;
         f.cutoff = tr[t_lad].cutoff;
-        if (probe(scene, &f, &ps, &rung[0], &spent, msg, msg_size) != 0)
+        /* where the scene needs polarized, the trees were rendered in L
+         * at the first rung: the ladder's tree is that rung already */
+        if ((pol_reason ? shot_copy(&ps, &tr[t_lad].s, &rung[0], msg, msg_size)
+                        : probe(scene, &f, &ps, &rung[0], &spent, msg, msg_size)) != 0)
             goto done;
         if (!pol_reason) {
             f.mode = RS_MODE_POLARIZED;
