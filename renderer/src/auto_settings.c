@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bvh.h"
 #include "camera.h"
 #include "shapes.h"
 
@@ -160,12 +161,54 @@ static int sees_lens(const rs_scene *s, lp_vec3 o, lp_vec3 d)
     return 0;
 }
 
+/* The lenses' boxes, which a camera ray must meet to see a lens (a hit an
+ * object reports lies in its box): testing them first spares the scene
+ * intersections of the pixels that cannot see one, most of the image,
+ * and changes no pixel's answer.  boxed 0: some lens has no box (or the
+ * scene no tree), so every pixel is intersected. */
+typedef struct lens_boxes {
+    int *lens; /* the lenses' object indices */
+    size_t n;
+    int boxed;
+} lens_boxes;
+
+static int lens_boxes_init(const rs_scene *s, lens_boxes *lb)
+{
+    lb->n = 0;
+    lb->boxed = s->bvh && rs_bvh_object_count(s->bvh) == s->n_objects;
+    lb->lens = malloc(sizeof *lb->lens * (s->n_objects + 1));
+    if (!lb->lens)
+        return -1;
+    for (size_t i = 0; i < s->n_objects; i++) {
+        if (s->objects[i].type != RS_OBJ_LENS)
+            continue;
+        lb->lens[lb->n++] = (int)i;
+        if (!rs_bvh_culls(s->bvh, (int)i))
+            lb->boxed = 0;
+    }
+    return 0;
+}
+
+/* Might the camera ray (o, d) meet a lens?  0 only when it cannot. */
+static int may_see_lens(const rs_scene *s, const lens_boxes *lb, lp_vec3 o, lp_vec3 d)
+{
+    rs_slab_ray r;
+    if (!lb->boxed)
+        return 1;
+    rs_slab_ray_init(&r, o, d);
+    for (size_t k = 0; k < lb->n; k++)
+        if (rs_bvh_may_meet(s->bvh, lb->lens[k], &r, 0.0, INFINITY))
+            return 1;
+    return 0;
+}
+
 /* Render the pixels px[2k], px[2k + 1] of the groups of sizes n[0..ng)
  * (one after another) with opts into out; the cost of each group's
- * renders (rs_work_cost) into gcost[g] and their sum added to *spent. */
+ * renders (rs_work_cost) into gcost[g], their work into gwork[g] (when
+ * not NULL) and the costs' sum added to *spent. */
 static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const int *px,
-                         const size_t *n, int ng, rs_color *out, double *gcost, double *spent,
-                         char *msg, size_t msg_size)
+                         const size_t *n, int ng, rs_color *out, double *gcost, rs_work *gwork,
+                         double *spent, char *msg, size_t msg_size)
 {
     rs_integrator *it;
     rs_worker *w;
@@ -186,6 +229,8 @@ static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const in
         rs_work d = {after.rays - before.rays, after.lane_rays - before.lane_rays,
                      after.builds - before.builds, after.gathered - before.gathered};
         gcost[g] = rs_work_cost(&d, opts->mode, (double)n[g]);
+        if (gwork)
+            gwork[g] = d;
         *spent += gcost[g];
         before = after;
     }
@@ -274,7 +319,7 @@ static int pilot_mark(const rs_scene *s, const rs_render_opts *base, int polariz
     f.wavelengths = 1;
     {
         double gc;
-        if (render_pixels(s, &f, px, &n, 1, c, &gc, spent, msg, msg_size) != 0)
+        if (render_pixels(s, &f, px, &n, 1, c, &gc, NULL, spent, msg, msg_size) != 0)
             goto out;
     }
     for (int pass = 0; pass < (polarized ? 1 : 2); pass++) {
@@ -311,15 +356,18 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
         return -1;
     unsigned char *group = malloc((size_t)total);
     unsigned char *mark = calloc((size_t)total, 1);
-    if (!group || !mark) {
+    lens_boxes lb = {NULL, 0, 0};
+    if (!group || !mark || lens_boxes_init(s, &lb) != 0) {
         free(group);
         free(mark);
+        free(lb.lens);
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
     if (pilot_mark(s, base, polarized, step, mark, spent, msg, msg_size) != 0) {
         free(group);
         free(mark);
+        free(lb.lens);
         return -1;
     }
     for (int j = 0; j < height; j++)
@@ -327,12 +375,13 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
             lp_vec3 o, d;
             long k = (long)j * width + i;
             rs_camera_ray(&view, i + 0.5, j + 0.5, width, height, &o, &d);
-            int lens = sees_lens(s, o, d);
+            int lens = may_see_lens(s, &lb, o, d) && sees_lens(s, o, d);
             int g = mark[k] ? G_MARKED : lens ? G_LENS : G_OTHER;
             group[k] = (unsigned char)g;
             count[g]++;
             ps->lens_share += lens ? 1.0 / (double)total : 0.0;
         }
+    free(lb.lens);
     /* A marked pixel (cell_pixel) stands for its pilot cell (at most what
      * there is); the other groups share the rest in proportion. */
     {
@@ -392,6 +441,7 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
 typedef struct shot {
     rs_color *c;
     double cost;
+    rs_work work[N_GROUPS]; /* what each group's render traced */
 } shot;
 
 static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set *ps, shot *out,
@@ -404,13 +454,37 @@ static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set 
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
-    if (render_pixels(s, opts, ps->px, ps->n, N_GROUPS, out->c, gc, spent, msg, msg_size) != 0)
+    if (render_pixels(s, opts, ps->px, ps->n, N_GROUPS, out->c, gc, out->work, spent, msg,
+                      msg_size) != 0)
         return -1;
     out->cost = 0.0;
     for (int g = 0; g < N_GROUPS; g++)
         if (ps->n[g])
             out->cost += gc[g] * ps->pop[g] / (double)ps->n[g];
     return 0;
+}
+
+/* A copy of a probe render into *to (its own colours). */
+static int shot_copy(const probe_set *ps, const shot *from, shot *to, char *msg, size_t msg_size)
+{
+    size_t n = ps->n[G_MARKED] + ps->n[G_LENS] + ps->n[G_OTHER];
+    *to = *from;
+    to->c = malloc(sizeof *to->c * (n + 1));
+    if (!to->c) {
+        snprintf(msg, msg_size, "out of memory");
+        return -1;
+    }
+    memcpy(to->c, from->c, sizeof *to->c * n);
+    return 0;
+}
+
+static int same_work(const shot *a, const shot *b)
+{
+    for (int g = 0; g < N_GROUPS; g++)
+        if (a->work[g].rays != b->work[g].rays || a->work[g].lane_rays != b->work[g].lane_rays ||
+            a->work[g].builds != b->work[g].builds || a->work[g].gathered != b->work[g].gathered)
+            return 0;
+    return 1;
 }
 
 /* RMS difference over the image, estimated from the probe: each group's
@@ -452,6 +526,63 @@ typedef struct tree {
     shot s;    /* the ladder's model at the first rung */
     double e;  /* e_tree */
 } tree;
+
+/* Does tree b trace every ray tree a traces?  It does where it is no
+ * shallower and cuts no higher: a branch's weight does not depend on the
+ * tree, so b stops only where a stops too. */
+static int nests(const tree *a, const tree *b)
+{
+    return a->depth <= b->depth && a->cutoff >= b->cutoff;
+}
+
+/* Every tree's probe render with base at its depth and cut-off (the
+ * trees depth by depth, shallowest first; each depth's cut-offs loosest
+ * first).  A tree t between two rendered trees a and b (a nests in t, t
+ * in b) that traced the same -- every counter of every group -- traces
+ * what a traces and renders as a does: it is copied, not rendered.  So
+ * the deepest depth goes first, then the shallowest, then the others
+ * shallow to deep, each depth's tightest cut-off first, then its loosest,
+ * then the others loose to tight: an equal pair then stands for the
+ * trees between (a scene whose light is all traced by depth 8 renders
+ * depth 16 as 8 and 32). */
+static int probe_trees(const rs_scene *s, const rs_render_opts *base, const probe_set *ps,
+                       tree *tr, int n_trees, double *spent, char *msg, size_t msg_size)
+{
+    int first[TREES_MAX + 1], n_depths = 0, order[TREES_MAX], n_order = 0;
+    int done[TREES_MAX];
+    for (int t = 0; t < n_trees; t++) {
+        done[t] = 0;
+        if (t == 0 || tr[t].depth != tr[t - 1].depth)
+            first[n_depths++] = t;
+    }
+    first[n_depths] = n_trees;
+    for (int k = 0; k < n_depths; k++) {
+        int d = k == 0 ? n_depths - 1 : k - 1, b0 = first[d], b1 = first[d + 1];
+        order[n_order++] = b1 - 1;
+        for (int t = b0; t < b1 - 1; t++)
+            order[n_order++] = t;
+    }
+    for (int k = 0; k < n_order; k++) {
+        int t = order[k], a = -1;
+        for (int i = 0; i < n_trees && a < 0; i++)
+            for (int j = 0; j < n_trees && a < 0; j++)
+                if (done[i] && done[j] && nests(&tr[i], &tr[t]) && nests(&tr[t], &tr[j]) &&
+                    same_work(&tr[i].s, &tr[j].s))
+                    a = i;
+        if (a >= 0) {
+            if (shot_copy(ps, &tr[a].s, &tr[t].s, msg, msg_size) != 0)
+                return -1;
+        } else {
+            rs_render_opts f = *base;
+            f.depth = tr[t].depth;
+            f.cutoff = tr[t].cutoff;
+            if (probe(s, &f, ps, &tr[t].s, spent, msg, msg_size) != 0)
+                return -1;
+        }
+        done[t] = 1;
+    }
+    return 0;
+}
 
 typedef struct choice {
     rs_mode mode;
@@ -517,7 +648,7 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     double dn = dispersion_max(scene, &n_lenses);
     probe_set ps = {NULL, {0, 0, 0}, {0, 0, 0}, 0.0, {0, 0, 0}};
     tree tr[TREES_MAX];
-    shot rung[RUNGS_MAX], pol = {NULL, 0.0}, sch = {NULL, 0.0}, rgb[TREES_MAX];
+    shot rung[RUNGS_MAX], pol, sch, rgb[TREES_MAX];
     int rung_n[RUNGS_MAX];
     double e_top = INFINITY, e_model[4] = {0, 0, 0, 0}, mcost[4] = {1, 1, 1, 1};
     double rung_spent = 0.0;
@@ -528,6 +659,8 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     memset(tr, 0, sizeof tr);
     memset(rung, 0, sizeof rung);
     memset(rgb, 0, sizeof rgb);
+    memset(&pol, 0, sizeof pol);
+    memset(&sch, 0, sizeof sch);
     rs_render_opts_init(&o);
     o.width = req->width;
     o.height = req->height;
@@ -582,16 +715,14 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
      * scene needs it, polarized at the first rung; e_tree against T*. */
     o.mode = L;
     o.wavelengths = req->wavelengths > 0 ? req->wavelengths : N_FIRST;
-    for (int t = 0; t < n_trees; t++) {
+    {
         rs_render_opts f = o;
         f.mode = pol_reason ? RS_MODE_POLARIZED : RS_MODE_RGB;
-        f.depth = tr[t].depth;
-        f.cutoff = tr[t].cutoff;
-        if (probe(scene, &f, &ps, &tr[t].s, &spent, msg, msg_size) != 0)
+        if (probe_trees(scene, &f, &ps, tr, n_trees, &spent, msg, msg_size) != 0)
             goto done;
-        if (!pol_reason)
-            rgb[t] = tr[t].s; /* not owned */
     }
+    for (int t = 0; t < n_trees && !pol_reason; t++)
+        rgb[t] = tr[t].s; /* not owned */
     for (int t = 0; t < n_trees; t++)
         tr[t].e = rms_diff(&ps, tr[t].s.c, tr[t_star].s.c) + e_star;
     /* The ladder's tree: the cheapest within TREE_LADDER of E. */
@@ -606,7 +737,10 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         rs_render_opts f = o;
         f.depth = tr[t_lad].depth;
         f.cutoff = tr[t_lad].cutoff;
-        if (probe(scene, &f, &ps, &rung[0], &spent, msg, msg_size) != 0)
+        /* where the scene needs polarized, the trees were rendered in L
+         * at the first rung: the ladder's tree is that rung already */
+        if ((pol_reason ? shot_copy(&ps, &tr[t_lad].s, &rung[0], msg, msg_size)
+                        : probe(scene, &f, &ps, &rung[0], &spent, msg, msg_size)) != 0)
             goto done;
         if (!pol_reason) {
             f.mode = RS_MODE_POLARIZED;
