@@ -2017,13 +2017,13 @@ double rs_work_cost(const rs_work *w, rs_mode mode, double pixels)
     /* bench/work_cost_fit.sh prints this body */
     switch (mode) {
     case RS_MODE_POLARIZED:
-        return 1930.0 * w->rays + 134.2 * w->lane_rays + 1171.0 * w->gathered + 1761.5 * pixels;
+        return 2024.4 * w->rays + 86.1 * w->lane_rays + 771.6 * w->gathered + 1815.6 * pixels;
     case RS_MODE_FRESNEL:
-        return 1558.1 * w->rays + 98.9 * w->lane_rays + 6.8 * w->builds + 1445.8 * pixels;
+        return 1503.7 * w->rays + 95.7 * w->lane_rays + 1600.6 * pixels;
     case RS_MODE_SCHLICK:
-        return 1553.3 * w->rays + 99.3 * w->lane_rays + 16.3 * w->builds + 1447.7 * pixels;
+        return 1501.2 * w->rays + 96.1 * w->lane_rays + 1602.9 * pixels;
     case RS_MODE_RGB:
-        return 1894.0 * w->rays + 11.6 * w->lane_rays + 1272.5 * pixels;
+        return 1896.8 * w->rays + 9.9 * w->lane_rays + 1268.1 * pixels;
     }
     return 0.0;
 }
