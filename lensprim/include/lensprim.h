@@ -620,6 +620,31 @@ LP_API lp_status lp_backward_gather(const lp_backward *bw, size_t q,
                                     const lp_ray *bundle, size_t n,
                                     lp_result *out, lp_error *err);
 
+/* (Revision 2) Many gathers in one call, of one builder or of many: the
+ * same as lp_backward_gather(bw[k], q[k], bundle[k], n[k], out, err) for
+ * k = 0, 1, ..., count-1 in turn, every gather appending to the one out:
+ * the same outgoing rays, bit for bit and in that order, and the same
+ * sums.  start[k] is set to out->count as gather k begins, so request k's
+ * rays are out->rays[start[k] .. start[k+1]) (the last one's up to
+ * out->count); start may be NULL.  For a spectral renderer whose packet
+ * splits into one wavelength per builder at a dispersive lens
+ * (lp_backward_build_many), each gather a ray or two: the rays of many
+ * requests are carried through their own ways side by side, in loops over
+ * them that the compiler vectorizes, so the call costs less than the
+ * gathers one by one.  The first gather that fails stops the call: its
+ * status is returned with lp_backward_gather's message prefixed by
+ * "request k: ", out holds what gathers 0 .. k-1 appended and what gather
+ * k appended before it failed (from start[k] on), and requests k+1 ..
+ * count-1 are not gathered (start[k+1 ..) not set): a caller that wants
+ * them calls again from k + 1.  count = 0 does nothing and returns LP_OK.
+ * A NULL out, or a NULL bw, q, bundle or n when count > 0, gives
+ * LP_ERROR_INVALID_ARGUMENT before any gather; a NULL bw[k], or a NULL
+ * bundle[k] with n[k] > 0, fails gather k as lp_backward_gather does. */
+LP_API lp_status lp_backward_gather_many(const lp_backward *const *bw, const size_t *q,
+                                         const lp_ray *const *bundle, const size_t *n,
+                                         size_t count, lp_result *out, size_t *start,
+                                         lp_error *err);
+
 /* ------------------------------------------------------------------ */
 /* The cone K of rim-free directions (the paper's section 5)           */
 /* ------------------------------------------------------------------ */

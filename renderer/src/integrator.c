@@ -167,6 +167,16 @@ typedef struct frame {
     lp_ray *g_rays; /* the groups' first rays, side by side */
     size_t g_rcap;
     unsigned char *bad; /* per lane: a gather failed */
+    /* A dispersive lens hit's gathers in one call (gather_all): per
+     * gather, in order, its query's traced bundle and the call's
+     * arguments, the lane it belongs to and where its outputs start */
+    bundle *kids;
+    size_t n_kids; /* bundles allocated */
+    const lp_backward **gm_bw;
+    const lp_ray **gm_b;
+    size_t *gm_q, *gm_n, *gm_start;
+    int *gm_lane;
+    size_t gm_cap;
     /* A spectral packet's split at this level (n_lanes entries each). */
     int *lane, *pos;
     double *val, *acc;
@@ -475,6 +485,19 @@ static void frame_free(frame *fr)
     free(fr->g_count);
     free(fr->g_rays);
     free(fr->bad);
+    for (size_t k = 0; k < fr->n_kids; k++) {
+        free(fr->kids[k].r);
+        free(fr->kids[k].lane);
+        free(fr->kids[k].I);
+        free(fr->kids[k].has);
+    }
+    free(fr->kids);
+    free(fr->gm_bw);
+    free(fr->gm_b);
+    free(fr->gm_q);
+    free(fr->gm_n);
+    free(fr->gm_start);
+    free(fr->gm_lane);
     free(fr->cb);
     free(fr->hs);
     free(fr->light_v);
@@ -1777,6 +1800,112 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
 static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
                           const rs_hit *hit, int level, double weight, int f, bundle *out);
 
+/* Room in fr for n gathers of gather_all (the bundles kept from one lens
+ * hit to the next).  Returns -1 when out of memory. */
+static int gather_room(frame *fr, size_t n)
+{
+    if (n > fr->n_kids) {
+        size_t cap = 2 * fr->n_kids > n ? 2 * fr->n_kids : n;
+        bundle *kids = realloc(fr->kids, cap * sizeof *kids);
+        if (!kids)
+            return -1;
+        memset(kids + fr->n_kids, 0, (cap - fr->n_kids) * sizeof *kids);
+        fr->kids = kids;
+        fr->n_kids = cap;
+    }
+    if (n > fr->gm_cap) {
+        size_t cap = 2 * fr->gm_cap > n ? 2 * fr->gm_cap : n;
+        void **arr[6] = {(void **)&fr->gm_bw, (void **)&fr->gm_b, (void **)&fr->gm_q,
+                         (void **)&fr->gm_n, (void **)&fr->gm_start, (void **)&fr->gm_lane};
+        size_t size[6] = {sizeof *fr->gm_bw, sizeof *fr->gm_b, sizeof *fr->gm_q,
+                          sizeof *fr->gm_n, sizeof *fr->gm_start, sizeof *fr->gm_lane};
+        for (int k = 0; k < 6; k++) {
+            void *p = realloc(*arr[k], cap * size[k]);
+            if (!p)
+                return -1;
+            *arr[k] = p;
+        }
+        fr->gm_cap = cap;
+    }
+    return 0;
+}
+
+/* Whether every sub-packet of lens_builds of a packet of n lanes is one
+ * lane (a wavelength of its own: n of them), and there are several, at a
+ * lens that is not a crystal. */
+static int lens_single(const frame *fr, const rs_object *ob, int n)
+{
+    return fr->n_sub == n && n > 1 && !ob->u.lens.desc.uniaxial;
+}
+
+/* The lens branch of trace_pol_hit where every sub-packet of the hit h
+ * (of lens_builds) is one lane and the lens is not a crystal: every
+ * query of every sub-packet traced, in order (for each sub-packet, each
+ * of its queries, as the loop of trace_pol_hit traces them: the wavelets
+ * and the counters come in that order), each into its own bundle; then
+ * all of them gathered in one lp_backward_gather_many, which carries the
+ * rays of many wavelengths side by side, and the outputs appended to out
+ * in the same order, their optical paths then counted from the ray's
+ * origin (shift_op, by h->t).  A gather that fails gives nothing, as
+ * there; out of memory, the branch stops where it is, as there. */
+static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, double weight,
+                       int f, bundle *out, size_t start)
+{
+    const rs_scene *sc = w->it->scene;
+    size_t nr = 0;
+    int m;
+    while ((m = lens_next(fr)) > 0) { /* m is 1 */
+        size_t nq = lp_backward_query_count(fr->bw);
+        const lp_query *q = lp_backward_queries(fr->bw);
+        ++w->splits; /* a lens hit's id, as trace_pol_hit counts them */
+        w->work.builds += 1.0;
+        if (gather_room(fr, nr + nq) != 0)
+            return;
+        for (size_t j = 0; j < nq; j++) {
+            bundle *c = &fr->kids[nr];
+            bundle_clear(c);
+            trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir,
+                          query_hit(sc, fr, q, j, lens_object(sc, h)), level + q[j].depth,
+                          weight * q[j].bound, f + 1, c);
+            if (c->n == 0)
+                continue;
+            w->work.gathered += (double)c->n;
+            fr->gm_bw[nr] = fr->bw;
+            fr->gm_q[nr] = j;
+            fr->gm_b[nr] = c->r;
+            fr->gm_n[nr] = c->n;
+            fr->gm_lane[nr] = fr->lane[0];
+            nr++;
+        }
+    }
+    /* a failed gather stops the call: its outputs are dropped, and the
+     * gathers after it made by another (it is the last whose start is set) */
+    lp_result_clear(&fr->res);
+    for (size_t from = 0; from < nr;) {
+        for (size_t k = from; k < nr; k++)
+            fr->gm_start[k] = SIZE_MAX;
+        if (lp_backward_gather_many(fr->gm_bw + from, fr->gm_q + from, fr->gm_b + from,
+                                    fr->gm_n + from, nr - from, &fr->res, fr->gm_start + from,
+                                    NULL) == LP_OK)
+            break;
+        size_t k = from;
+        while (k + 1 < nr && fr->gm_start[k + 1] != SIZE_MAX)
+            k++;
+        fr->res.count = fr->gm_start[k];
+        from = k + 1;
+    }
+    for (size_t k = 0; k < nr; k++) {
+        size_t end = k + 1 < nr ? fr->gm_start[k + 1] : fr->res.count;
+        for (size_t t = fr->gm_start[k]; t < end; t++) {
+            lp_ray *r = bundle_push(out, fr->gm_lane[k]);
+            if (!r)
+                return;
+            *r = fr->res.rays[t].ray;
+        }
+    }
+    shift_op(out, start, h->t);
+}
+
 static void trace_pol(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d, int level,
                       double weight, int skip, int f, bundle *out)
 {
@@ -1829,6 +1958,10 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
         fr->qm.valid = 0;
         if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a) != 0)
             return;
+        if (lens_single(fr, ob, n)) { /* their gathers at once */
+            gather_all(w, fr, &h, level, weight, f, out, start);
+            return;
+        }
         while ((m = lens_next(fr)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);

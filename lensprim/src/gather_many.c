@@ -1,0 +1,621 @@
+/* gather_many.c -- lp_backward_gather_many: the gathers of many builders
+ * at once, a lane per request, each lane along its own way.
+ *
+ * A spectral renderer splits its packet at a dispersive lens into one
+ * wavelength per builder (lp_backward_build_many), and each wavelength's
+ * query is answered by a bundle of a ray or two (the two halves of
+ * natural light): gathered builder by builder, the lanes of
+ * lp__gather_lanes are half empty and the checks and set-up of a call are
+ * paid for every two rays.  Here the rays of many requests are taken
+ * together instead.  Along a way the lanes take (complex_at >= 0: no node
+ * at normal incidence, total internal reflection only where the light
+ * reflects) every ray takes the same kind of step at each node -- the
+ * light reflects at a query's entry when its depth is 1 and refracts in
+ * otherwise, reflects inside at nodes k-1..2 and refracts out at node 1;
+ * its field is real down to the first node under total internal
+ * reflection and complex from there (gather_lanes.c) -- so the requests
+ * whose ways have the same depth, the same first such node and
+ * absorption or none walk them side by side, a lane per request reading
+ * its own way's axes and factors, copied once into arrays per lane, in
+ * loops over lanes that the compiler vectorizes (lanes.h).  A lane
+ * carries two rays of its request (natural light's two halves: a
+ * renderer's bundles are mostly those), so that the way is read once for
+ * both; a request of more rays takes more lanes, and an odd one's last
+ * lane repeats its ray.  Each ray takes the one-ray code's operations in
+ * their order (trace_backward.c: gather_one; gather_lanes.c's
+ * gather_kernel is the same for one way, its steps on a complex field
+ * those of interface.c and cvec3.h part by part), so its numbers are that
+ * code's bit for bit, and the outgoing rays are stored request by
+ * request, ray by ray, as the gathers one by one store them.  A request
+ * the lanes do not take -- a crystal lens, a way of normal incidence, a
+ * bundle too long, a ray that fails its checks, a complex field that
+ * turns real again -- is gathered by lp_backward_gather itself in its
+ * turn, so its results (and its error) are that call's. */
+#include <math.h>
+
+#include "backward.h"
+#include "error.h"
+#include "lanes.h"
+
+/* Lanes per group. */
+#define GM 8
+
+/* A loop over the lanes of a group (lanes.h). */
+#define GM_LANES(i) LP__LANE_LOOP(i, GM)
+
+/* The deepest way taken in lanes (the renderer's are a few nodes deep). */
+#define GM_DEPTH 12
+
+/* Bundle rays taken per window of requests: the window's rays are
+ * gathered in lanes, then its requests stored in order. */
+#define GM_WINDOW 256
+
+/* The groups: 2 ((GM_DEPTH + 1) depth + complex_at) + absorbs. */
+#define GM_KEYS (2 * (GM_DEPTH + 1) * (GM_DEPTH + 1))
+
+/* The lanes of a group: each lane's way, its two rays (h = 0, 1), and
+ * what leaves. */
+typedef struct gm_lanes {
+    double lx[GM], ly[GM], lz[GM]; /* the light's direction at the entry */
+    double dx[GM], dy[GM], dz[GM]; /* the exit's (local) direction */
+    double ux[GM], uy[GM], uz[GM]; /* the lens frame */
+    double wvx[GM], wvy[GM], wvz[GM];
+    double wwx[GM], wwy[GM], wwz[GM];
+    /* per node j of the way (j = depth: the entry): its s and p axes,
+     * the branch's p axis, the branch's factors (rs, rp or ts, tp),
+     * the segment from node j + 1 (seg_abs, seg_att) */
+    double sx[GM_DEPTH + 1][GM], sy[GM_DEPTH + 1][GM], sz[GM_DEPTH + 1][GM];
+    double px[GM_DEPTH + 1][GM], py[GM_DEPTH + 1][GM], pz[GM_DEPTH + 1][GM];
+    double ax[GM_DEPTH + 1][GM], ay[GM_DEPTH + 1][GM], az[GM_DEPTH + 1][GM];
+    double fa[GM_DEPTH + 1][GM], fb[GM_DEPTH + 1][GM];
+    double fc[GM_DEPTH + 1][GM], fd[GM_DEPTH + 1][GM]; /* imaginary parts of rs, rp */
+    double sa[GM_DEPTH + 1][GM], st[GM_DEPTH + 1][GM];
+    /* per ray h of the lane */
+    double vx[2][GM], vy[2][GM], vz[2][GM]; /* in: world field directions */
+    double in[2][GM];                       /* in: intensities */
+    double ok[2][GM];                       /* 1: the field direction checks out */
+    double ex[2][GM], ey[2][GM], ez[2][GM]; /* the field, local (its real part) */
+    double fx[2][GM], fy[2][GM], fz[2][GM]; /* its imaginary part, once complex */
+    double odd[2][GM];                      /* 1: it turned real again (one by one) */
+    double ab[2][GM];                       /* power absorbed in the glass */
+    double fl[2][GM];                       /* phase jumps counted */
+    double pw[2][GM];                       /* out: the power leaving */
+    double wx[2][GM], wy[2][GM], wz[2][GM]; /* out: its world field direction */
+    /* a complex field's split (lp__field_split_elliptic): the square
+     * E.E, the ellipse's phase psi and exp(-i psi); out: the parts (0, 1
+     * or 2), the second one's power and world field direction */
+    double qr[2][GM], qi[2][GM], psi[2][GM], hr[2][GM], hi[2][GM];
+    double np[2][GM];
+    double pw1[2][GM];
+    double wx1[2][GM], wy1[2][GM], wz1[2][GM];
+} gm_lanes;
+
+/* The light's step at node j of a way of depth k: 1 a reflection (off
+ * the outside at the entry of depth 1, inside at nodes k-1..2), 0 a
+ * refraction (in at the entry, out at node 1); lp__backward_entry_way and
+ * lp__backward_light_way (and lp__backward_ways, bit for bit) set them so. */
+static int reflects(int j, int k)
+{
+    return j == k ? k == 1 : j > 1;
+}
+
+/* lp__bundle_ray_check of ray h of lane i (the local field direction,
+ * perpendicular to the light), then its amplitude. */
+LP__INLINE void gm_start(gm_lanes *restrict L, int h, int i, lp_vec3 u, lp_vec3 v, lp_vec3 w,
+                         lp_vec3 light)
+{
+    lp_vec3 b = v3(L->vx[h][i], L->vy[h][i], L->vz[h][i]);
+    lp_vec3 l = v3(v3_dot(b, u), v3_dot(b, v), v3_dot(b, w));
+    double ok;
+    lp_vec3 e = v3_scale(lp__perp_unit_core(l, light, &ok), sqrt(L->in[h][i]));
+    L->ok[h][i] = ok;
+    L->ex[h][i] = e.x, L->ey[h][i] = e.y, L->ez[h][i] = e.z;
+    L->fx[h][i] = L->fy[h][i] = L->fz[h][i] = 0.0;
+    L->odd[h][i] = 0.0;
+    L->ab[h][i] = 0.0;
+    L->fl[h][i] = 0.0;
+}
+
+/* Ray h of lane i over a segment (seg_abs sa, seg_att st). */
+LP__INLINE void gm_absorb(gm_lanes *restrict L, int h, int i, double sa, double st)
+{
+    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
+    L->ab[h][i] += v3_dot(e, e) * sa;
+    e = v3_scale(e, st);
+    L->ex[h][i] = e.x, L->ey[h][i] = e.y, L->ez[h][i] = e.z;
+}
+
+/* lp__node_reflect_real of ray h of lane i. */
+LP__INLINE void gm_reflect(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p, lp_vec3 ap,
+                           double rs, double rp)
+{
+    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
+    double es = v3_dot(e, s), ep = v3_dot(e, p);
+    int flip = rs * (es * es) - rp * (ep * ep) < 0.0;
+    double a = flip ? -rs : rs, c = flip ? -rp : rp;
+    e = v3_add(v3_scale(s, a * es), v3_scale(ap, c * ep));
+    L->ex[h][i] = e.x, L->ey[h][i] = e.y, L->ez[h][i] = e.z;
+    L->fl[h][i] += flip ? 1.0 : 0.0;
+}
+
+/* lp__node_transmit_real of ray h of lane i. */
+LP__INLINE void gm_transmit(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p,
+                            lp_vec3 ap, double ts, double tp)
+{
+    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
+    double es = v3_dot(e, s), ep = v3_dot(e, p);
+    e = v3_add(v3_scale(s, ts * es), v3_scale(ap, tp * ep));
+    L->ex[h][i] = e.x, L->ey[h][i] = e.y, L->ez[h][i] = e.z;
+}
+
+/* lp__field_split_real and lp__emit_linear of ray h of lane i: the power
+ * and the world field direction of the ray leaving along the local d. */
+LP__INLINE void gm_leave(gm_lanes *restrict L, int h, int i, lp_vec3 d, lp_vec3 u, lp_vec3 v,
+                         lp_vec3 w)
+{
+    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
+    lp_vec3 c = lp__unit_perp(e, d);
+    lp_vec3 o = v3_add(v3_add(v3_scale(u, c.x), v3_scale(v, c.y)), v3_scale(w, c.z));
+    L->pw[h][i] = v3_dot(e, e);
+    L->wx[h][i] = o.x, L->wy[h][i] = o.y, L->wz[h][i] = o.z;
+}
+
+/* The steps on a complex field, gather_lanes.c's (gl_*) for ray h of
+ * lane i. */
+
+/* cv3_norm2, cv3_scale_real over a segment. */
+LP__INLINE void gmc_absorb(gm_lanes *restrict L, int h, int i, double sa, double st)
+{
+    double n2 = L->ex[h][i] * L->ex[h][i] + L->fx[h][i] * L->fx[h][i] +
+                L->ey[h][i] * L->ey[h][i] + L->fy[h][i] * L->fy[h][i] +
+                L->ez[h][i] * L->ez[h][i] + L->fz[h][i] * L->fz[h][i];
+    L->ab[h][i] += n2 * sa;
+    L->ex[h][i] *= st, L->ey[h][i] *= st, L->ez[h][i] *= st;
+    L->fx[h][i] *= st, L->fy[h][i] *= st, L->fz[h][i] *= st;
+}
+
+/* lp__node_project on the axes s, p (gl_project): a real field (cplx 0)
+ * has real amplitudes; a complex one whose imaginary part is zero is
+ * marked odd. */
+LP__INLINE void gmc_project(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p, int cplx,
+                            double *esr, double *esi, double *epr, double *epi)
+{
+    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
+    lp_vec3 f = v3(L->fx[h][i], L->fy[h][i], L->fz[h][i]);
+    *esr = v3_dot(e, s), *epr = v3_dot(e, p);
+    if (cplx) {
+        *esi = v3_dot(f, s), *epi = v3_dot(f, p);
+        L->odd[h][i] += (f.x == 0.0) & (f.y == 0.0) & (f.z == 0.0) ? 1.0 : 0.0;
+    } else {
+        *esi = 0.0, *epi = 0.0;
+    }
+}
+
+/* The field after a node, a s + b pr (gl_combine: cv3_combine). */
+LP__INLINE void gmc_combine(gm_lanes *restrict L, int h, int i, double ar, double ai, lp_vec3 s,
+                            double br, double bi, lp_vec3 pr)
+{
+    L->ex[h][i] = ar * s.x + br * pr.x, L->fx[h][i] = ai * s.x + bi * pr.x;
+    L->ey[h][i] = ar * s.y + br * pr.y, L->fy[h][i] = ai * s.y + bi * pr.y;
+    L->ez[h][i] = ar * s.z + br * pr.z, L->fz[h][i] = ai * s.z + bi * pr.z;
+}
+
+/* reflect_on with the complex rs = (rs, rsi), rp = (rp, rpi) (gl_reflect). */
+LP__INLINE void gmc_reflect(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p, lp_vec3 ap,
+                            double rs, double rsi, double rp, double rpi, int cplx)
+{
+    double esr, esi, epr, epi;
+    gmc_project(L, h, i, s, p, cplx, &esr, &esi, &epr, &epi);
+    double mirror = rs * (esr * esr + esi * esi) - rp * (epr * epr + epi * epi);
+    int flip = mirror < 0.0;
+    double a = flip ? -rs : rs, b = flip ? -rsi : rsi;
+    double c = flip ? -rp : rp, d = flip ? -rpi : rpi;
+    gmc_combine(L, h, i, a * esr - b * esi, a * esi + b * esr, s, c * epr - d * epi,
+                c * epi + d * epr, ap);
+    L->fl[h][i] += flip ? 1.0 : 0.0;
+}
+
+/* transmit_on of a complex field. */
+LP__INLINE void gmc_transmit(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p,
+                             lp_vec3 ap, double ts, double tp)
+{
+    double esr, esi, epr, epi;
+    gmc_project(L, h, i, s, p, 1, &esr, &esi, &epr, &epi);
+    gmc_combine(L, h, i, ts * esr, ts * esi, s, tp * epr, tp * epi, ap);
+}
+
+/* gl_split's first and last steps for ray h of lane i: cv3_norm2,
+ * cv3_is_real and E.E; then, psi and exp(-i psi) known, the parts. */
+LP__INLINE void gmc_square(gm_lanes *restrict L, int h, int i)
+{
+    double ex = L->ex[h][i], ey = L->ey[h][i], ez = L->ez[h][i];
+    double fx = L->fx[h][i], fy = L->fy[h][i], fz = L->fz[h][i];
+    L->pw[h][i] = ex * ex + fx * fx + ey * ey + fy * fy + ez * ez + fz * fz;
+    L->odd[h][i] += (fx == 0.0) & (fy == 0.0) & (fz == 0.0) ? 1.0 : 0.0;
+    L->qr[h][i] = (ex * ex - fx * fx) + (ey * ey - fy * fy) + (ez * ez - fz * fz);
+    L->qi[h][i] = (ex * fx + fx * ex) + (ey * fy + fy * ey) + (ez * fz + fz * ez);
+}
+
+LP__INLINE void gmc_parts(gm_lanes *restrict L, int h, int i, lp_vec3 d, lp_vec3 u, lp_vec3 v,
+                          lp_vec3 w)
+{
+    double ex = L->ex[h][i], ey = L->ey[h][i], ez = L->ez[h][i];
+    double fx = L->fx[h][i], fy = L->fy[h][i], fz = L->fz[h][i];
+    double hr = L->hr[h][i], hi = L->hi[h][i], total = L->pw[h][i];
+    int same = L->psi[h][i] == 0.0;
+    lp_vec3 a = v3(same ? ex : ex * hr - fx * hi, same ? ey : ey * hr - fy * hi,
+                   same ? ez : ez * hr - fz * hi);
+    lp_vec3 b = v3(same ? fx : ex * hi + fx * hr, same ? fy : ey * hi + fy * hr,
+                   same ? fz : ez * hi + fz * hr);
+    double ia = v3_dot(a, a), ib = v3_dot(b, b);
+    int one = ib <= 1e-20 * total;
+    lp_vec3 ca = lp__unit_perp(a, d), cb = lp__unit_perp(b, d);
+    lp_vec3 o = v3_add(v3_add(v3_scale(u, ca.x), v3_scale(v, ca.y)), v3_scale(w, ca.z));
+    lp_vec3 o1 = v3_add(v3_add(v3_scale(u, cb.x), v3_scale(v, cb.y)), v3_scale(w, cb.z));
+    L->np[h][i] = !(total > 0.0) ? 0.0 : (one ? 1.0 : 2.0);
+    L->pw[h][i] = one ? total : ia;
+    L->wx[h][i] = o.x, L->wy[h][i] = o.y, L->wz[h][i] = o.z;
+    L->pw1[h][i] = ib;
+    L->wx1[h][i] = o1.x, L->wy1[h][i] = o1.y, L->wz1[h][i] = o1.z;
+}
+
+/* Every lane's two rays through its way of depth k (all lanes alike),
+ * its field complex below node jc (0: real all the way), absorbing on
+ * the segments where absorbs: gather_kernel's steps; the lanes from g on
+ * (repeating lane 0) are not split (psi 0). */
+LP__WIDE static void gm_kernel(gm_lanes *restrict L, int k, int jc, int absorbs, int g)
+{
+    GM_LANES(i) {
+        lp_vec3 u = v3(L->ux[i], L->uy[i], L->uz[i]);
+        lp_vec3 v = v3(L->wvx[i], L->wvy[i], L->wvz[i]);
+        lp_vec3 w = v3(L->wwx[i], L->wwy[i], L->wwz[i]);
+        lp_vec3 light = v3(L->lx[i], L->ly[i], L->lz[i]);
+        gm_start(L, 0, i, u, v, w, light);
+        gm_start(L, 1, i, u, v, w, light);
+    }
+    /* the way, in the light's direction: way_step_real while the field is
+     * real (j > jc), way_step on a complex one */
+    for (int j = k; j >= 1; j--) {
+        const int cplx = j < jc; /* the field arriving is complex */
+        if (j < k && absorbs) { /* over the segment from node j + 1 */
+            if (cplx)
+                GM_LANES(i) {
+                    gmc_absorb(L, 0, i, L->sa[j][i], L->st[j][i]);
+                    gmc_absorb(L, 1, i, L->sa[j][i], L->st[j][i]);
+                }
+            else
+                GM_LANES(i) {
+                    gm_absorb(L, 0, i, L->sa[j][i], L->st[j][i]);
+                    gm_absorb(L, 1, i, L->sa[j][i], L->st[j][i]);
+                }
+        }
+        if (j <= jc && reflects(j, k)) { /* lp__node_project, reflect_on, complex */
+            if (cplx)
+                GM_LANES(i) {
+                    lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
+                    lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
+                    lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
+                    double rs = L->fa[j][i], rp = L->fb[j][i];
+                    double rsi = L->fc[j][i], rpi = L->fd[j][i];
+                    gmc_reflect(L, 0, i, s, p, ap, rs, rsi, rp, rpi, 1);
+                    gmc_reflect(L, 1, i, s, p, ap, rs, rsi, rp, rpi, 1);
+                }
+            else
+                GM_LANES(i) {
+                    lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
+                    lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
+                    lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
+                    double rs = L->fa[j][i], rp = L->fb[j][i];
+                    double rsi = L->fc[j][i], rpi = L->fd[j][i];
+                    gmc_reflect(L, 0, i, s, p, ap, rs, rsi, rp, rpi, 0);
+                    gmc_reflect(L, 1, i, s, p, ap, rs, rsi, rp, rpi, 0);
+                }
+        } else if (j <= jc) { /* lp__node_project, transmit_on, complex */
+            GM_LANES(i) {
+                lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
+                lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
+                lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
+                gmc_transmit(L, 0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                gmc_transmit(L, 1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+            }
+        } else if (reflects(j, k)) { /* lp__node_reflect_real */
+            GM_LANES(i) {
+                lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
+                lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
+                lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
+                gm_reflect(L, 0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                gm_reflect(L, 1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+            }
+        } else { /* lp__node_transmit_real */
+            GM_LANES(i) {
+                lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
+                lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
+                lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
+                gm_transmit(L, 0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                gm_transmit(L, 1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+            }
+        }
+    }
+    if (jc > 0) { /* lp__field_split of a complex field (gl_split) */
+        GM_LANES(i) {
+            gmc_square(L, 0, i);
+            gmc_square(L, 1, i);
+        }
+        for (int i = 0; i < GM; i++)
+            for (int h = 0; h < 2; h++) {
+                double psi = 0.0;
+                double complex e = 1.0;
+                if (i < g) { /* the lanes in use: the phase lane by lane */
+                    psi = lp__ellipse_psi(CMPLX(L->qr[h][i], L->qi[h][i]));
+                    e = psi == 0.0 ? 1.0 : lp__phasor_minus(psi);
+                }
+                L->psi[h][i] = psi, L->hr[h][i] = creal(e), L->hi[h][i] = cimag(e);
+            }
+        GM_LANES(i) {
+            lp_vec3 d = v3(L->dx[i], L->dy[i], L->dz[i]);
+            lp_vec3 u = v3(L->ux[i], L->uy[i], L->uz[i]);
+            lp_vec3 v = v3(L->wvx[i], L->wvy[i], L->wvz[i]);
+            lp_vec3 w = v3(L->wwx[i], L->wwy[i], L->wwz[i]);
+            gmc_parts(L, 0, i, d, u, v, w);
+            gmc_parts(L, 1, i, d, u, v, w);
+        }
+        return;
+    }
+    GM_LANES(i) {
+        lp_vec3 d = v3(L->dx[i], L->dy[i], L->dz[i]);
+        lp_vec3 u = v3(L->ux[i], L->uy[i], L->uz[i]);
+        lp_vec3 v = v3(L->wvx[i], L->wvy[i], L->wvz[i]);
+        lp_vec3 w = v3(L->wwx[i], L->wwy[i], L->wwz[i]);
+        gm_leave(L, 0, i, d, u, v, w);
+        gm_leave(L, 1, i, d, u, v, w);
+    }
+}
+
+/* Whether a bundle ray passes the checks of lp__bundle_ray_check that
+ * come before its field direction's (gather_lanes.c's). */
+static int ray_fine(const lp_ray *b)
+{
+    return isfinite(b->intensity) && !(b->intensity < 0.0) && isfinite(b->op) &&
+           isfinite(b->phase) && v3_finite(b->vp);
+}
+
+/* Whether the lanes take request (bw, q, bundle[0..n)): a polarized
+ * build's query (its ways set up) whose way lanes take (complex_at >= 0),
+ * not too deep, its rays fine and few enough. */
+static int in_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n)
+{
+    if (!bw || !bundle || n == 0 || n > GM_WINDOW || !bw->ways || lp__xback_active(bw->xb) ||
+        q >= bw->n_queries || bw->complex_at[q] < 0 || bw->query[q].depth > GM_DEPTH)
+        return 0;
+    for (size_t i = 0; i < n; i++)
+        if (!ray_fine(&bundle[i]))
+            return 0;
+    return 1;
+}
+
+/* Node j of lane i's way: w's axes and factors (the imaginary parts of a
+ * reflection's where im: a node the complex steps take). */
+LP__INLINE void way_in(gm_lanes *L, int i, int j, const lp__bw_way *w, int im)
+{
+    const lp__node *nd = &w->node;
+    L->sx[j][i] = nd->s.x, L->sy[j][i] = nd->s.y, L->sz[j][i] = nd->s.z;
+    L->px[j][i] = nd->p.x, L->py[j][i] = nd->p.y, L->pz[j][i] = nd->p.z;
+    L->ax[j][i] = w->ax.p.x, L->ay[j][i] = w->ax.p.y, L->az[j][i] = w->ax.p.z;
+    if (w->reflect) {
+        L->fa[j][i] = creal(nd->f.rs), L->fb[j][i] = creal(nd->f.rp);
+        if (im)
+            L->fc[j][i] = cimag(nd->f.rs), L->fd[j][i] = cimag(nd->f.rp);
+    } else {
+        L->fa[j][i] = nd->f.ts, L->fb[j][i] = nd->f.tp;
+    }
+}
+
+/* Lane i of L takes query q of bw (in_lanes; its field complex below
+ * node jc, absorbing where absorbs) and its rays b[0] and b[1] (b[0]
+ * twice where two is 0): what gm_kernel reads of them. */
+LP__INLINE void lane_in(gm_lanes *L, int i, const lp_backward *bw, size_t q, const lp_ray *b,
+                        int two, int jc, int absorbs)
+{
+    const lp_lens *lens = bw->lens;
+    const int k = bw->query[q].depth;
+    const lp__bw_way *entry = &bw->entry[q];
+    const lp_vec3 light = entry->node.d, d = bw->exit.d;
+    const lp_ray *b1 = two ? b + 1 : b;
+    L->vx[0][i] = b->vp.x, L->vy[0][i] = b->vp.y, L->vz[0][i] = b->vp.z;
+    L->in[0][i] = b->intensity;
+    L->vx[1][i] = b1->vp.x, L->vy[1][i] = b1->vp.y, L->vz[1][i] = b1->vp.z;
+    L->in[1][i] = b1->intensity;
+    L->lx[i] = light.x, L->ly[i] = light.y, L->lz[i] = light.z;
+    L->dx[i] = d.x, L->dy[i] = d.y, L->dz[i] = d.z;
+    L->ux[i] = lens->u.x, L->uy[i] = lens->u.y, L->uz[i] = lens->u.z;
+    L->wvx[i] = lens->v.x, L->wvy[i] = lens->v.y, L->wvz[i] = lens->v.z;
+    L->wwx[i] = lens->w.x, L->wwy[i] = lens->w.y, L->wwz[i] = lens->w.z;
+    way_in(L, i, k, entry, jc >= k);
+    for (int j = k - 1; j >= 1; j--) {
+        way_in(L, i, j, &bw->light[j], j <= jc);
+        if (absorbs)
+            L->sa[j][i] = bw->node[j].seg_abs, L->st[j][i] = bw->node[j].seg_att;
+    }
+}
+
+/* A window of requests: per request whether the lanes take it (its group,
+ * else -1) and the place of its first ray; per ray (request by request,
+ * each one's rays in order) what leaves. */
+typedef struct gm_window {
+    int key[GM_WINDOW];
+    size_t ray[GM_WINDOW];
+    int order[GM_WINDOW]; /* the requests, by group */
+    double ok[GM_WINDOW], pw[GM_WINDOW], ab[GM_WINDOW], fl[GM_WINDOW];
+    double wx[GM_WINDOW], wy[GM_WINDOW], wz[GM_WINDOW];
+    /* a complex field's: the parts, the second's power and direction, the
+     * phase (ok is 0 where it turned real again) */
+    double np[GM_WINDOW], pw1[GM_WINDOW], psi[GM_WINDOW];
+    double wx1[GM_WINDOW], wy1[GM_WINDOW], wz1[GM_WINDOW];
+    /* the group being filled: its lanes' first rays' places in the
+     * window and how many rays each has (1 or 2) */
+    size_t at[GM];
+    int two[GM];
+    /* and its first lane's request and first ray there */
+    size_t k0, i0;
+} gm_window;
+
+/* Run the g lanes of group `key` filled, the lanes past g repeating the
+ * first, and keep what leaves at the rays' places. */
+static void run_group(gm_window *W, gm_lanes *L, int g, int key, const lp_backward *const *bw,
+                      const size_t *q, const lp_ray *const *bundle)
+{
+    int jc = (key >> 1) % (GM_DEPTH + 1);
+    for (int i = g; i < GM; i++)
+        lane_in(L, i, bw[W->k0], q[W->k0], &bundle[W->k0][W->i0], W->two[0], jc, key & 1);
+    gm_kernel(L, (key >> 1) / (GM_DEPTH + 1), jc, key & 1, g);
+    for (int i = 0; i < g; i++)
+        for (int h = 0; h <= W->two[i]; h++) {
+            size_t t = W->at[i] + (size_t)h;
+            W->ok[t] = L->odd[h][i] != 0.0 ? 0.0 : L->ok[h][i];
+            W->pw[t] = L->pw[h][i];
+            W->ab[t] = L->ab[h][i];
+            W->fl[t] = L->fl[h][i];
+            W->wx[t] = L->wx[h][i], W->wy[t] = L->wy[h][i], W->wz[t] = L->wz[h][i];
+            if (jc > 0) {
+                W->np[t] = L->np[h][i];
+                W->pw1[t] = L->pw1[h][i];
+                W->psi[t] = L->psi[h][i];
+                W->wx1[t] = L->wx1[h][i], W->wy1[t] = L->wy1[h][i], W->wz1[t] = L->wz1[h][i];
+            }
+        }
+}
+
+/* Gather the rays of requests k0 .. k0+m the lanes take, group by group,
+ * GM lanes at a time, two rays a lane. */
+static void run_window(gm_window *W, gm_lanes *L, size_t k0, size_t m,
+                       const lp_backward *const *bw, const size_t *q,
+                       const lp_ray *const *bundle, const size_t *n)
+{
+    /* a counting sort, stable: count[key + 2] of each group, then their
+     * starts (the requests left out, key -1, first) */
+    int count[GM_KEYS + 2] = {0};
+    for (size_t r = 0; r < m; r++)
+        count[W->key[r] + 2]++;
+    for (int g = 1; g < GM_KEYS + 2; g++)
+        count[g] += count[g - 1];
+    int first = count[1];
+    for (size_t r = 0; r < m; r++)
+        W->order[count[W->key[r] + 1]++] = (int)r;
+    int g = 0, key = -1;
+    for (int o = first; o < (int)m; o++) {
+        size_t r = (size_t)W->order[o], k = k0 + r;
+        if (g > 0 && W->key[r] != key) {
+            run_group(W, L, g, key, bw, q, bundle);
+            g = 0;
+        }
+        key = W->key[r];
+        const int jc = (key >> 1) % (GM_DEPTH + 1), absorbs = key & 1;
+        for (size_t i = 0; i < n[k]; i += 2) {
+            int two = i + 1 < n[k];
+            if (g == 0)
+                W->k0 = k, W->i0 = i;
+            lane_in(L, g, bw[k], q[k], &bundle[k][i], two, jc, absorbs);
+            W->at[g] = W->ray[r] + i;
+            W->two[g] = two;
+            if (++g == GM) {
+                run_group(W, L, g, key, bw, q, bundle);
+                g = 0;
+            }
+        }
+    }
+    if (g > 0)
+        run_group(W, L, g, key, bw, q, bundle);
+}
+
+/* Store request r's rays, from place t of the window, into out as
+ * lp_backward_gather does (lp__gather_lanes). */
+static lp_status store(const gm_window *W, size_t t, const lp_backward *bw, size_t q,
+                       const lp_ray *b, size_t n, lp_result *out, lp_error *err)
+{
+    const lp_query *qr = &bw->query[q];
+    out->warnings |= bw->warnings;
+    for (size_t i = 0; i < n; i++, t++) {
+        lp__payload pl = {bw->optics.lambda_nm, b[i].kphi + (int)W->fl[t], b[i].op + qr->op,
+                          b[i].phase, b[i].ch};
+        double before = out->out;
+        out->in += b[i].intensity;
+        out->nodes += (size_t)qr->depth;
+        if (bw->complex_at[q] > 0) { /* lp__emit_gathered_parts of the split */
+            for (int p = 0; p < (int)W->np[t]; p++) {
+                lp_status st = lp__emit_ray(
+                    out, &bw->exit, &pl, qr->depth, qr->kind, qr->surface, qr->path, qr->waves,
+                    p, p ? W->pw1[t] : W->pw[t],
+                    p ? v3(W->wx1[t], W->wy1[t], W->wz1[t]) : v3(W->wx[t], W->wy[t], W->wz[t]),
+                    p ? W->psi[t] + 0.5 * LP_PI : W->psi[t], err);
+                if (st != LP_OK)
+                    return st;
+            }
+        } else if (W->pw[t] > 0.0) { /* lp__field_split_real: one part */
+            lp_status st = lp__emit_ray(out, &bw->exit, &pl, qr->depth, qr->kind, qr->surface,
+                                        qr->path, qr->waves, 0, W->pw[t],
+                                        v3(W->wx[t], W->wy[t], W->wz[t]), 0.0, err);
+            if (st != LP_OK)
+                return st;
+        }
+        lp__gathered_rest(out, before, b[i].intensity, W->ab[t]);
+    }
+    return LP_OK;
+}
+
+lp_status lp_backward_gather_many(const lp_backward *const *bw, const size_t *q,
+                                  const lp_ray *const *bundle, const size_t *n, size_t count,
+                                  lp_result *out, size_t *start, lp_error *err)
+{
+    gm_window W;
+    gm_lanes L;
+
+    if (!out || (count > 0 && (!bw || !q || !bundle || !n)))
+        return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_gather_many: NULL argument");
+    for (size_t k0 = 0; k0 < count;) {
+        /* a window: the requests from k0 whose rays fit, each marked with
+         * its group if the lanes take it */
+        size_t m = 0, rays = 0;
+        while (k0 + m < count && m < GM_WINDOW) {
+            size_t k = k0 + m;
+            const lp_backward *b = bw[k];
+            W.key[m] = -1;
+            if (in_lanes(b, q[k], bundle[k], n[k])) {
+                if (rays + n[k] > GM_WINDOW)
+                    break;
+                int depth = b->query[q[k]].depth, jc = b->complex_at[q[k]];
+                W.key[m] = 2 * ((GM_DEPTH + 1) * depth + jc) + (b->optics.alpha > 0.0);
+                W.ray[m] = rays;
+                rays += n[k];
+            }
+            m++;
+        }
+        if (rays > 0)
+            run_window(&W, &L, k0, m, bw, q, bundle, n);
+        /* the window's requests in order: from the lanes where every ray's
+         * field direction checked out (and no complex field turned real),
+         * else by lp_backward_gather */
+        for (size_t r = 0; r < m; r++) {
+            size_t k = k0 + r;
+            lp_status st;
+            int in = W.key[r] >= 0;
+            for (size_t i = 0; in && i < n[k]; i++)
+                in = W.ok[W.ray[r] + i] != 0.0;
+            if (start)
+                start[k] = out->count;
+            if (in)
+                st = store(&W, W.ray[r], bw[k], q[k], bundle[k], n[k], out, err);
+            else
+                st = lp_backward_gather(bw[k], q[k], bundle[k], n[k], out, err);
+            if (st != LP_OK) {
+                if (err) {
+                    lp_error e = *err;
+                    lp__fail(err, st, "request %zu: %s", k, e.message);
+                }
+                return st;
+            }
+        }
+        k0 += m;
+    }
+    lp__ok(err);
+    return LP_OK;
+}

@@ -1,0 +1,325 @@
+/* test_gather_many.c -- lp_backward_gather_many, the gathers of many
+ * builders in one call.
+ *
+ * identity   For placed and tilted lenses of every kind (dispersive
+ *            catalog glasses with absorption, one in a dispersive medium,
+ *            a ball whose chains totally reflect inside, a flat plate seen
+ *            along its axis, a conical rim, a uniaxial crystal), view rays
+ *            of every kind, depths 1, 2, 5, 12 and 16, builders of 16
+ *            wavelengths (lp_backward_build_many) in the polarized mode
+ *            and some in the fresnel mode: requests through every query
+ *            of every builder, in builder order or interleaved, with
+ *            bundles of 0 to 20 rays (random field directions and
+ *            intensities, some 0), some of them failing (an intensity
+ *            that is not a number, a field along the light, a query that
+ *            does not exist, a NULL builder or bundle), are gathered by
+ *            lp_backward_gather_many and by lp_backward_gather one by one
+ *            into results already holding rays.  Every status and
+ *            message ("request k: " and lp_backward_gather's), every
+ *            request's start, every outgoing ray (as bytes) and every sum
+ *            must be identical; after a failure both go on from the next
+ *            request.  The contract is exactness, so the tolerance is 0.
+ * errors     NULL arguments; count = 0.
+ */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+#include "splitmix.h"
+#include "same_bits.h"
+#include "lensprim.h"
+
+#define PI 3.14159265358979323846
+#define NW 16
+#define MAX_REQ (NW * 64)
+#define MAX_RAYS 20
+
+static uint64_t rng = 0x6a7e4e11a5ull;
+static double uniform(void)
+{
+    return splitmix_uniform(&rng);
+}
+
+static lp_vec3 vec(double x, double y, double z)
+{
+    lp_vec3 v = {x, y, z};
+    return v;
+}
+
+static lp_vec3 place(lp_vec3 pos, lp_vec3 u, lp_vec3 v, lp_vec3 w, double x, double y,
+                     double z)
+{
+    return vec(pos.x + x * u.x + y * v.x + z * w.x, pos.y + x * u.y + y * v.y + z * w.y,
+               pos.z + x * u.z + y * v.z + z * w.z);
+}
+
+static lp_backward *bws[NW];
+
+/* The requests of a case. */
+static const lp_backward *req_bw[MAX_REQ];
+static size_t req_q[MAX_REQ], req_n[MAX_REQ];
+static const lp_ray *req_b[MAX_REQ];
+static lp_ray rays[MAX_REQ][MAX_RAYS];
+
+static int n_cases, n_requests, n_rays, n_failed, n_out;
+
+/* A bundle ray arriving back along the world direction qd (lambda_nm):
+ * a random field direction, or one that fails (bad 1: an intensity that
+ * is not a number, 2: a field along the light). */
+static lp_ray bundle_ray(lp_vec3 qd, double lambda_nm, int bad)
+{
+    lp_ray r;
+    r.origin = vec(0, 0, 0);
+    r.dir = vec(-qd.x, -qd.y, -qd.z);
+    r.lambda_nm = lambda_nm;
+    double u = uniform();
+    r.intensity = u < 0.1 ? 0.0 : 3.0 * uniform();
+    r.vp = vec(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5);
+    r.kphi = (int)(4.0 * uniform());
+    r.op = 10.0 * uniform();
+    r.phase = 6.0 * uniform() - 3.0;
+    r.ch = (uint64_t)(1000.0 * uniform());
+    if (bad == 1)
+        r.intensity = NAN;
+    else if (bad == 2)
+        r.vp = qd;
+    return r;
+}
+
+/* The requests k of [from, count) one by one into a, the many call into
+ * b; both results compared, and each request's start.  Returns the
+ * request after the first that failed (count when none did). */
+static size_t compare_from(const char *name, size_t from, size_t count, lp_result *a,
+                           lp_result *b)
+{
+    size_t start_a[MAX_REQ], start_b[MAX_REQ];
+    lp_error ea, eb;
+    lp_status sa = LP_OK;
+    size_t k = from;
+    char want[400] = "";
+
+    for (; k < count; k++) {
+        start_a[k] = a->count;
+        sa = lp_backward_gather(req_bw[k], req_q[k], req_b[k], req_n[k], a, &ea);
+        if (sa != LP_OK) {
+            snprintf(want, sizeof want, "request %zu: %s", k - from, ea.message);
+            break;
+        }
+    }
+    for (size_t i = from; i < count; i++)
+        start_b[i] = SIZE_MAX;
+    lp_status sb = lp_backward_gather_many(req_bw + from, req_q + from, req_b + from,
+                                           req_n + from, count - from, b, start_b + from, &eb);
+    CHECK(sa == sb, "%s: status %d / %d (%s)", name, (int)sa, (int)sb, eb.message);
+    if (sa != LP_OK) {
+        CHECK(strcmp(eb.message, want) == 0, "%s: '%s', want '%s'", name, eb.message, want);
+        n_failed++;
+    }
+    size_t last = k < count ? k : count - 1;
+    for (size_t i = from; i <= last && i < count; i++)
+        CHECK(start_a[i] == start_b[i], "%s: request %zu starts at %zu / %zu", name, i,
+              start_a[i], start_b[i]);
+    for (size_t i = last + 1; i < count; i++)
+        CHECK(start_b[i] == SIZE_MAX, "%s: request %zu after the failure is set", name, i);
+    CHECK(same_books(a, b), "%s: the sums or counts differ (%zu / %zu rays)", name, a->count,
+          b->count);
+    size_t differ = 0;
+    for (size_t t = 0; t < a->count && t < b->count; t++)
+        differ += !same_out_ray(&a->rays[t], &b->rays[t]);
+    CHECK(differ == 0, "%s: %zu of %zu outgoing rays differ", name, differ, a->count);
+    return k < count ? k + 1 : count;
+}
+
+/* The requests of the builders bws[0..nb) (their queries, in builder
+ * order or interleaved query by query), bad: some fail; gathered both
+ * ways. */
+static void gather_case(const char *name, size_t nb, const double *lambda, int interleave,
+                        int bad)
+{
+    static lp_result a, b;
+    size_t count = 0, nq_max = 0;
+    for (size_t s = 0; s < nb; s++)
+        if (lp_backward_query_count(bws[s]) > nq_max)
+            nq_max = lp_backward_query_count(bws[s]);
+    for (size_t o = 0; o < nb * (nq_max + 1); o++) {
+        size_t s = interleave ? o % nb : o / (nq_max + 1);
+        size_t j = interleave ? o / nb : o % (nq_max + 1);
+        size_t nq = lp_backward_query_count(bws[s]);
+        if (j > nq || (j == nq && !(bad && uniform() < 0.05)) || count == MAX_REQ)
+            continue; /* j == nq: a query that does not exist */
+        const lp_query *qs = lp_backward_queries(bws[s]);
+        lp_vec3 qd = j < nq ? qs[j].dir : vec(0, 0, 1);
+        double u = uniform();
+        size_t n = u < 0.05 ? 0 : u < 0.6 ? 2 : u < 0.8 ? 1 : (size_t)(MAX_RAYS * uniform());
+        for (size_t i = 0; i < n; i++)
+            rays[count][i] = bundle_ray(qd, lambda[s], bad && uniform() < 0.02 ? 1 + (int)(2.0 * uniform()) : 0);
+        req_bw[count] = bws[s];
+        req_q[count] = j;
+        req_n[count] = n;
+        req_b[count] = rays[count];
+        if (bad && uniform() < 0.01)
+            req_bw[count] = NULL;
+        if (bad && n > 0 && uniform() < 0.01)
+            req_b[count] = NULL;
+        if (n == 0 && uniform() < 0.5)
+            req_b[count] = NULL; /* no rays: NULL is fine */
+        n_rays += (int)n;
+        count++;
+    }
+    /* both results hold the same rays already: the calls append */
+    lp_result_clear(&a);
+    lp_result_clear(&b);
+    if (count > 0 && req_bw[0] && req_b[0]) {
+        lp_backward_gather(req_bw[0], req_q[0], req_b[0], req_n[0], &a, NULL);
+        lp_backward_gather(req_bw[0], req_q[0], req_b[0], req_n[0], &b, NULL);
+    }
+    for (size_t from = 0; from < count;)
+        from = compare_from(name, from, count, &a, &b);
+    n_out += (int)a.count;
+    n_requests += (int)count;
+    n_cases++;
+}
+
+static void test_identity(void)
+{
+    struct {
+        const char *name;
+        double r1, r2, t, d, d2;
+        const char *glass;   /* catalog, or NULL: constant n */
+        double n;
+        const char *medium;  /* catalog medium, or NULL: air */
+        int crystal;
+    } shapes[] = {
+        {"biconvex N-BK7", 50, -50, 8, 25, 0, "N-BK7", 0, NULL, 0},
+        {"ball N-SF11", 10, -10, 19, 19.9, 0, "N-SF11", 0, NULL, 0},
+        {"meniscus F2 in CaF2", 20, 40, 4, 20, 0, "F2", 0, "CAF2", 0},
+        {"flat plate N-SF6", 0, 0, 3, 20, 0, "N-SF6", 0, NULL, 0},
+        {"conical rim n=1.6", 60, -30, 6, 24, 18, NULL, 1.6, NULL, 0},
+        {"biconcave SF11", -30, 30, 3, 22, 0, "N-SF11", 0, NULL, 0},
+        {"crystal plate", 0, 0, 3, 20, 0, NULL, 0, NULL, 1},
+    };
+    const int depths[] = {1, 2, 5, 12, 16};
+    lp_error err;
+
+    for (size_t si = 0; si < sizeof shapes / sizeof shapes[0]; si++) {
+        lp_lens_desc desc;
+        lp_lens *lens;
+        lp_lens_desc_init(&desc);
+        desc.radius1 = shapes[si].r1;
+        desc.radius2 = shapes[si].r2;
+        desc.thickness = shapes[si].t;
+        desc.diameter = shapes[si].d;
+        desc.diameter2 = shapes[si].d2;
+        if (shapes[si].crystal) {
+            desc.uniaxial = 1;
+            lp_crystal_init_constant(&desc.crystal, 1.658, 1.486, vec(0.3, 0.5, 0.8));
+        } else if (shapes[si].glass) {
+            CHECK(lp_glass_builtin(shapes[si].glass, &desc.glass, &err) == LP_OK, "%s",
+                  err.message);
+        } else {
+            lp_glass_init_constant(&desc.glass, shapes[si].n);
+        }
+        if (shapes[si].medium)
+            CHECK(lp_glass_builtin(shapes[si].medium, &desc.medium, &err) == LP_OK, "%s",
+                  err.message);
+        double th = 0.3 + 0.1 * (double)si, ph = 0.9 * (double)si;
+        lp_vec3 w = vec(sin(th) * cos(ph), sin(th) * sin(ph), cos(th));
+        desc.axis = w;
+        desc.position = vec(-2.0 * (double)si, 1.0, 4.0);
+        if (lp_lens_create(&desc, &lens, &err) != LP_OK) {
+            CHECK(0, "%s: %s", shapes[si].name, err.message);
+            continue;
+        }
+        lp_lens_get_desc(lens, &desc);
+        lp_vec3 u = fabs(w.x) < 0.6 ? vec(1, 0, 0) : vec(0, 1, 0);
+        double uw = u.x * w.x + u.y * w.y + u.z * w.z;
+        u = vec(u.x - uw * w.x, u.y - uw * w.y, u.z - uw * w.z);
+        double ul = sqrt(u.x * u.x + u.y * u.y + u.z * u.z);
+        u = vec(u.x / ul, u.y / ul, u.z / ul);
+        lp_vec3 v = vec(w.y * u.z - w.z * u.y, w.z * u.x - w.x * u.z, w.x * u.y - w.y * u.x);
+        double h = 0.5 * desc.diameter, t = desc.thickness;
+        for (int ri = 0; ri < 24; ri++) {
+            lp_vec3 o, d;
+            int kind = ri % 4;
+            if (kind == 0) { /* along the axis, from the front */
+                o = place(desc.position, u, v, w, 0, 0, -3.0 * h);
+                d = w;
+            } else { /* from either side, steep or grazing */
+                double rho = 1.1 * h * sqrt(uniform()), phi = 2.0 * PI * uniform();
+                double tilt = (kind == 3 ? 1.4 : 0.7) * uniform(), az = 2.0 * PI * uniform();
+                double side = kind == 2 ? t + 3.0 * h : -3.0 * h;
+                o = place(desc.position, u, v, w, rho * cos(phi), rho * sin(phi), side);
+                d = place(vec(0, 0, 0), u, v, w, sin(tilt) * cos(az), sin(tilt) * sin(az),
+                          (side < 0.0 ? 1.0 : -1.0) * cos(tilt));
+            }
+            double lambda[NW];
+            for (size_t k = 0; k < NW; k++)
+                lambda[k] = 400.0 + 300.0 * uniform();
+            lp_trace_args a;
+            lp_trace_args_init(&a);
+            a.mode = ri % 6 == 5 ? LP_MODE_FRESNEL : LP_MODE_POLARIZED;
+            a.max_depth = depths[ri % 5];
+            size_t nb = ri % 5 == 4 ? 3 : NW;
+            CHECK(lp_backward_build_many(bws, nb, lens, o, d, lambda, &a, &err) == LP_OK,
+                  "%s: build: %s", shapes[si].name, err.message);
+            char name[160];
+            for (int c = 0; c < 4; c++) {
+                snprintf(name, sizeof name, "%s, view ray %d, depth %d, %s%s", shapes[si].name,
+                         ri, a.max_depth, c & 1 ? "interleaved" : "builder by builder",
+                         c & 2 ? ", failing" : "");
+                gather_case(name, nb, lambda, c & 1, c >> 1);
+            }
+        }
+        lp_lens_destroy(lens);
+    }
+    printf("identity: %d cases, %d requests, %d bundle rays, %d outgoing rays, %d failures: "
+           "every status, message, start, ray and sum identical to lp_backward_gather's\n",
+           n_cases, n_requests, n_rays, n_out, n_failed);
+    CHECK(n_failed > 0 && n_out > 0, "failures and outgoing rays were exercised");
+}
+
+static void test_errors(void)
+{
+    lp_result r;
+    lp_error err;
+    size_t q = 0, n = 0, start = 7;
+    const lp_backward *b = bws[0];
+    const lp_ray *bundle = NULL;
+    lp_result_init(&r);
+    CHECK(lp_backward_gather_many(&b, &q, &bundle, &n, 1, NULL, &start, &err) ==
+              LP_ERROR_INVALID_ARGUMENT,
+          "NULL out");
+    CHECK(lp_backward_gather_many(NULL, &q, &bundle, &n, 1, &r, &start, &err) ==
+              LP_ERROR_INVALID_ARGUMENT,
+          "NULL builders");
+    CHECK(lp_backward_gather_many(&b, NULL, &bundle, &n, 1, &r, &start, &err) ==
+              LP_ERROR_INVALID_ARGUMENT,
+          "NULL queries");
+    CHECK(lp_backward_gather_many(&b, &q, NULL, &n, 1, &r, &start, &err) ==
+              LP_ERROR_INVALID_ARGUMENT,
+          "NULL bundles");
+    CHECK(lp_backward_gather_many(&b, &q, &bundle, NULL, 1, &r, &start, &err) ==
+              LP_ERROR_INVALID_ARGUMENT,
+          "NULL counts");
+    CHECK(start == 7 && r.count == 0, "nothing done before the arguments check out");
+    CHECK(lp_backward_gather_many(NULL, NULL, NULL, NULL, 0, &r, NULL, &err) == LP_OK,
+          "count = 0: nothing to do");
+    CHECK(r.count == 0 && r.in == 0.0, "count = 0 leaves out as it is");
+    lp_result_release(&r);
+}
+
+int main(void)
+{
+    lp_error err;
+    for (int k = 0; k < NW; k++)
+        if (lp_backward_create(&bws[k], &err) != LP_OK)
+            return 1;
+    test_identity();
+    test_errors();
+    for (int k = 0; k < NW; k++)
+        lp_backward_destroy(bws[k]);
+    return check_finish("test_gather_many");
+}
