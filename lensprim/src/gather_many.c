@@ -50,7 +50,7 @@
  * gathered in lanes, then its requests stored in order. */
 #define GM_WINDOW 256
 
-/* The groups: 2 ((GM_DEPTH + 1) depth + complex_at) + absorbs. */
+/* The groups' keys: 2 ((GM_DEPTH + 1) depth + complex_at) + absorbs. */
 #define GM_KEYS (2 * (GM_DEPTH + 1) * (GM_DEPTH + 1))
 
 /* The lanes of a group: each lane's way, its two rays (h = 0, 1), and
@@ -384,8 +384,9 @@ static int ray_fine(const lp_ray *b)
  * not too deep, its rays fine and few enough. */
 static int in_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n)
 {
-    if (!bw || !bundle || n == 0 || n > GM_WINDOW || !bw->ways || lp__xback_active(bw->xb) ||
-        q >= bw->n_queries || bw->complex_at[q] < 0 || bw->query[q].depth > GM_DEPTH)
+    /* (a build through a crystal sets no ways) */
+    if (!bw || !bundle || n == 0 || n > GM_WINDOW || !bw->ways || q >= bw->n_queries ||
+        bw->complex_at[q] < 0 || bw->query[q].depth > GM_DEPTH)
         return 0;
     for (size_t i = 0; i < n; i++)
         if (!ray_fine(&bundle[i]))
@@ -445,15 +446,18 @@ typedef struct gm_window {
     int key[GM_WINDOW];
     size_t ray[GM_WINDOW];
     int order[GM_WINDOW]; /* the requests, by group */
-    double ok[GM_WINDOW], pw[GM_WINDOW], ab[GM_WINDOW], fl[GM_WINDOW];
+    unsigned char bad[GM_WINDOW]; /* per request: a ray's field direction
+                                     fails, or a complex field turns real */
+    double pw[GM_WINDOW], ab[GM_WINDOW], fl[GM_WINDOW];
     double wx[GM_WINDOW], wy[GM_WINDOW], wz[GM_WINDOW];
     /* a complex field's: the parts, the second's power and direction, the
-     * phase (ok is 0 where it turned real again) */
+     * phase */
     double np[GM_WINDOW], pw1[GM_WINDOW], psi[GM_WINDOW];
     double wx1[GM_WINDOW], wy1[GM_WINDOW], wz1[GM_WINDOW];
     /* the group being filled: its lanes' first rays' places in the
      * window and how many rays each has (1 or 2) */
     size_t at[GM];
+    size_t req[GM];
     int two[GM];
     /* and its first lane's request and first ray there */
     size_t k0, i0;
@@ -471,7 +475,7 @@ static void run_group(gm_window *W, gm_lanes *L, int g, int key, const lp_backwa
     for (int i = 0; i < g; i++)
         for (int h = 0; h <= W->two[i]; h++) {
             size_t t = W->at[i] + (size_t)h;
-            W->ok[t] = L->odd[h][i] != 0.0 ? 0.0 : L->ok[h][i];
+            W->bad[W->req[i]] |= (L->ok[h][i] == 0.0) | (L->odd[h][i] != 0.0);
             W->pw[t] = L->pw[h][i];
             W->ab[t] = L->ab[h][i];
             W->fl[t] = L->fl[h][i];
@@ -491,31 +495,44 @@ static void run_window(gm_window *W, gm_lanes *L, size_t k0, size_t m,
                        const lp_backward *const *bw, const size_t *q,
                        const lp_ray *const *bundle, const size_t *n)
 {
-    /* a counting sort, stable: count[key + 2] of each group, then their
-     * starts (the requests left out, key -1, first) */
-    int count[GM_KEYS + 2] = {0};
+    /* the requests the lanes take by group, each group in the requests'
+     * order: a counting sort over the keys from the least to the largest
+     * in the window (a few queries' depths) */
+    int lo = GM_KEYS, hi = -1;
     for (size_t r = 0; r < m; r++)
-        count[W->key[r] + 2]++;
-    for (int g = 1; g < GM_KEYS + 2; g++)
-        count[g] += count[g - 1];
-    int first = count[1];
-    for (size_t r = 0; r < m; r++)
-        W->order[count[W->key[r] + 1]++] = (int)r;
-    int g = 0, key = -1;
-    for (int o = first; o < (int)m; o++) {
-        size_t r = (size_t)W->order[o], k = k0 + r;
-        if (g > 0 && W->key[r] != key) {
-            run_group(W, L, g, key, bw, q, bundle);
-            g = 0;
+        if (W->key[r] >= 0) {
+            lo = W->key[r] < lo ? W->key[r] : lo;
+            hi = W->key[r] > hi ? W->key[r] : hi;
         }
-        key = W->key[r];
-        const int jc = (key >> 1) % (GM_DEPTH + 1), absorbs = key & 1;
+    int count[GM_KEYS + 1];
+    for (int c = 0; c <= hi - lo + 1; c++)
+        count[c] = 0;
+    for (size_t r = 0; r < m; r++)
+        if (W->key[r] >= 0)
+            count[W->key[r] - lo + 1]++;
+    for (int c = 1; c <= hi - lo + 1; c++)
+        count[c] += count[c - 1];
+    int end = hi < 0 ? 0 : count[hi - lo + 1];
+    for (size_t r = 0; r < m; r++)
+        if (W->key[r] >= 0)
+            W->order[count[W->key[r] - lo]++] = (int)r;
+    int g = 0, key = -1, jc = 0, absorbs = 0;
+    for (int o = 0; o < end; o++) {
+        size_t r = (size_t)W->order[o], k = k0 + r;
+        if (W->key[r] != key) {
+            if (g > 0)
+                run_group(W, L, g, key, bw, q, bundle);
+            g = 0;
+            key = W->key[r];
+            jc = (key >> 1) % (GM_DEPTH + 1), absorbs = key & 1;
+        }
         for (size_t i = 0; i < n[k]; i += 2) {
             int two = i + 1 < n[k];
             if (g == 0)
                 W->k0 = k, W->i0 = i;
             lane_in(L, g, bw[k], q[k], &bundle[k][i], two, jc, absorbs);
             W->at[g] = W->ray[r] + i;
+            W->req[g] = r;
             W->two[g] = two;
             if (++g == GM) {
                 run_group(W, L, g, key, bw, q, bundle);
@@ -579,6 +596,7 @@ lp_status lp_backward_gather_many(const lp_backward *const *bw, const size_t *q,
             size_t k = k0 + m;
             const lp_backward *b = bw[k];
             W.key[m] = -1;
+            W.bad[m] = 0;
             if (in_lanes(b, q[k], bundle[k], n[k])) {
                 if (rays + n[k] > GM_WINDOW)
                     break;
@@ -597,9 +615,7 @@ lp_status lp_backward_gather_many(const lp_backward *const *bw, const size_t *q,
         for (size_t r = 0; r < m; r++) {
             size_t k = k0 + r;
             lp_status st;
-            int in = W.key[r] >= 0;
-            for (size_t i = 0; in && i < n[k]; i++)
-                in = W.ok[W.ray[r] + i] != 0.0;
+            int in = W.key[r] >= 0 && !W.bad[r];
             if (start)
                 start[k] = out->count;
             if (in)
