@@ -81,6 +81,15 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
  * (not through a crystal). */
 void lp__backward_built(lp_backward *bw);
 
+/* lp__backward_built of bw[0..n) (distinct builders), bit for bit, their
+ * ways set up in lanes across the builds (lp__backward_ways_many). */
+void lp__backward_built_many(lp_backward *const *bw, size_t n);
+
+/* Whether a build of bw sets up its gathers' ways (a polarized one, not
+ * through a crystal), and the depth of its deepest query (0: none). */
+int lp__backward_sets_ways(const lp_backward *bw);
+int lp__backward_deepest(const lp_backward *bw);
+
 /* The way where the light of query qi enters the lens, and the way of
  * node j of the light's way back (trace_backward.c), into *w. */
 void lp__backward_entry_way(const lp_backward *bw, size_t qi, lp__bw_way *w);
@@ -102,5 +111,10 @@ size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, s
  * lp__backward_light_way, bit for bit, set up in lanes
  * (backward_ways.c). */
 void lp__backward_ways(lp_backward *bw, int deepest);
+
+/* lp__backward_ways of every bw[k] that sets up its ways
+ * (lp__backward_sets_ways), to its deepest query, bit for bit: the
+ * lanes' groups filled across the builds. */
+void lp__backward_ways_many(lp_backward *const *bw, size_t n);
 
 #endif

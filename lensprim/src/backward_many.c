@@ -435,8 +435,8 @@ lp_status lp_backward_build_many(lp_backward *const *bw, size_t n, const lp_lens
                     build_group(bw + k0, ok - k0 < NW ? ok - k0 : NW, lens, &K, d, &h);
             }
         }
-        for (size_t k = 0; k < ok; k++)
-            lp__backward_built(bw[k]);
+        if (a.mode == LP_MODE_POLARIZED) /* else no build sets up ways */
+            lp__backward_built_many(bw, ok);
         if (ok == n) {
             lp__ok(err);
             return LP_OK;

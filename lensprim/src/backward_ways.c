@@ -5,7 +5,9 @@
  * back (trace_backward.c: lp__backward_entry_way, lp__backward_light_way):
  * each is lp__node_setup of the light's direction and the surface normal
  * there with the axes of the branch the light takes.  Those of one build
- * are set up side by side, in loops over lanes that the compiler
+ * -- or of the many builds of lp_backward_build_many, whose few ways each
+ * (a query or two and the nodes between) would leave the groups half
+ * empty -- are set up side by side, in loops over lanes that the compiler
  * vectorizes (lanes.h), each lane with the operations of the one-node
  * code (interface.h, fresnel.h) in their order, so that its numbers are
  * that code's bit for bit.  A node that code treats apart -- total
@@ -98,7 +100,7 @@ static lp__bw_way *way_at(lp_backward *bw, size_t k)
 }
 
 /* Lane i of L takes way k of bw. */
-static void lane_in(const lp_backward *bw, size_t k, wl_lanes *L, int i)
+LP__INLINE void lane_in(const lp_backward *bw, size_t k, wl_lanes *L, int i)
 {
     const lp__optics *o = &bw->optics;
     lp_vec3 d, m;
@@ -125,7 +127,7 @@ static void lane_in(const lp_backward *bw, size_t k, wl_lanes *L, int i)
 }
 
 /* Way k of bw from lane i of L. */
-static void lane_out(lp_backward *bw, size_t k, const wl_lanes *L, int i)
+LP__INLINE void lane_out(lp_backward *bw, size_t k, const wl_lanes *L, int i)
 {
     lp__bw_way *w = way_at(bw, k);
     if (L->apart[i] != 0.0) {
@@ -172,4 +174,37 @@ void lp__backward_ways(lp_backward *bw, int deepest)
         for (int i = 0; i < m; i++)
             lane_out(bw, k0 + (size_t)i, &L, i);
     }
+}
+
+void lp__backward_ways_many(lp_backward *const *bw, size_t n)
+{
+    wl_lanes L;
+    lp_backward *who[WL]; /* each lane's build and way */
+    size_t way[WL];
+    int m = 0, first = 1;
+    for (size_t b = 0; b < n; b++) {
+        if (!lp__backward_sets_ways(bw[b]))
+            continue;
+        int deepest = lp__backward_deepest(bw[b]);
+        size_t nw = bw[b]->n_queries + (size_t)(deepest > 1 ? deepest - 1 : 0);
+        for (size_t k = 0; k < nw; k++) {
+            lane_in(bw[b], k, &L, m);
+            who[m] = bw[b], way[m] = k;
+            if (++m == WL) {
+                ways_kernel(&L);
+                for (int i = 0; i < WL; i++)
+                    lane_out(who[i], way[i], &L, i);
+                m = 0, first = 0;
+            }
+        }
+    }
+    if (m == 0)
+        return;
+    /* the last group: lanes past m repeat the first in a first group, and
+     * keep the group before's ways (set up for nothing) after it */
+    for (int i = m; first && i < WL; i++)
+        lane_in(who[0], way[0], &L, i);
+    ways_kernel(&L);
+    for (int i = 0; i < m; i++)
+        lane_out(who[i], way[i], &L, i);
 }

@@ -117,20 +117,22 @@ void lp__backward_light_way(const lp_backward *bw, int j, lp__bw_way *w)
         lp__node_transmit_axes(&w->node, &w->ax);
 }
 
-/* The ways of every query of a polarized build (backward.h). */
-void lp__backward_built(lp_backward *bw)
+int lp__backward_deepest(const lp_backward *bw)
 {
-    if (bw->args.mode != LP_MODE_POLARIZED || lp__xback_active(bw->xb))
-        return;
     int deepest = 0;
     for (size_t qi = 0; qi < bw->n_queries; qi++)
         if (bw->query[qi].depth > deepest)
             deepest = bw->query[qi].depth;
-    lp__backward_ways(bw, deepest);
-    /* where each way's fields turn complex, if the lanes take it: at[j]
-     * for the light's way from node j - 1 down (-1: not in lanes; 0: the
-     * field stays real; else the first node under total internal
-     * reflection), then each query's from its entry on */
+    return deepest;
+}
+
+/* Once bw's ways are set up (lp__backward_ways): where each way's fields
+ * turn complex, if the lanes take it: at[j] for the light's way from
+ * node j - 1 down (-1: not in lanes; 0: the field stays real; else the
+ * first node under total internal reflection), then each query's from
+ * its entry on. */
+static void mark_ways(lp_backward *bw, int deepest)
+{
     signed char at[LP_MAX_DEPTH + 1];
     at[1] = 0;
     for (int j = 1; j < deepest; j++) {
@@ -147,6 +149,30 @@ void lp__backward_built(lp_backward *bw)
                                                : tir ? k : at[k]);
     }
     bw->ways = 1;
+}
+
+int lp__backward_sets_ways(const lp_backward *bw)
+{
+    return bw->args.mode == LP_MODE_POLARIZED && !lp__xback_active(bw->xb);
+}
+
+/* The ways of every query of a polarized build (backward.h). */
+void lp__backward_built(lp_backward *bw)
+{
+    if (!lp__backward_sets_ways(bw))
+        return;
+    int deepest = lp__backward_deepest(bw);
+    lp__backward_ways(bw, deepest);
+    mark_ways(bw, deepest);
+}
+
+/* Those of many builds, set up in lanes across them (backward.h). */
+void lp__backward_built_many(lp_backward *const *bw, size_t n)
+{
+    lp__backward_ways_many(bw, n);
+    for (size_t k = 0; k < n; k++)
+        if (lp__backward_sets_ways(bw[k]))
+            mark_ways(bw[k], lp__backward_deepest(bw[k]));
 }
 
 /* Field E through way node w in the direction of light, into *br. */
