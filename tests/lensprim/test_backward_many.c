@@ -35,6 +35,7 @@
 #include "splitmix.h"
 #include "same_bits.h"
 #include "lensprim.h"
+#include "placed_lens.h"
 
 #define PI 3.14159265358979323846
 #define MAX_WL 40
@@ -43,19 +44,6 @@ static uint64_t rng = 0xb4c3a11e5ull;
 static double uniform(void)
 {
     return splitmix_uniform(&rng);
-}
-
-static lp_vec3 vec(double x, double y, double z)
-{
-    lp_vec3 v = {x, y, z};
-    return v;
-}
-
-static lp_vec3 place(lp_vec3 pos, lp_vec3 u, lp_vec3 v, lp_vec3 w, double x, double y,
-                     double z)
-{
-    return vec(pos.x + x * u.x + y * v.x + z * w.x, pos.y + x * u.y + y * v.y + z * w.y,
-               pos.z + x * u.z + y * v.z + z * w.z);
 }
 
 /* The filter's calls, logged: every argument, in order. */
@@ -194,14 +182,7 @@ static void identity_case(const char *name, const lp_lens *lens, lp_vec3 o, lp_v
 
 static void test_identity(void)
 {
-    struct {
-        const char *name;
-        double r1, r2, t, d, d2;
-        const char *glass;   /* catalog, or NULL: constant n */
-        double n;
-        const char *medium;  /* catalog medium, or NULL: air */
-        int crystal;
-    } shapes[] = {
+    const placed_shape shapes[] = {
         {"biconvex N-BK7", 50, -50, 8, 25, 0, "N-BK7", 0, NULL, 0},
         {"ball N-SF11", 10, -10, 19, 19.9, 0, "N-SF11", 0, NULL, 0},
         {"meniscus F2 in CaF2", 20, 40, 4, 20, 0, "F2", 0, "CAF2", 0},
@@ -212,44 +193,13 @@ static void test_identity(void)
     };
     const size_t counts[] = {1, 3, 16, 17, 40};
     const int depths[] = {1, 2, 5, 12};
-    lp_error err;
 
     for (size_t si = 0; si < sizeof shapes / sizeof shapes[0]; si++) {
         lp_lens_desc desc;
         lp_lens *lens;
-        lp_lens_desc_init(&desc);
-        desc.radius1 = shapes[si].r1;
-        desc.radius2 = shapes[si].r2;
-        desc.thickness = shapes[si].t;
-        desc.diameter = shapes[si].d;
-        desc.diameter2 = shapes[si].d2;
-        if (shapes[si].crystal) {
-            desc.uniaxial = 1;
-            lp_crystal_init_constant(&desc.crystal, 1.658, 1.486, vec(0.3, 0.5, 0.8));
-        } else if (shapes[si].glass) {
-            CHECK(lp_glass_builtin(shapes[si].glass, &desc.glass, &err) == LP_OK, "%s",
-                  err.message);
-        } else {
-            lp_glass_init_constant(&desc.glass, shapes[si].n);
-        }
-        if (shapes[si].medium)
-            CHECK(lp_glass_builtin(shapes[si].medium, &desc.medium, &err) == LP_OK, "%s",
-                  err.message);
-        double th = 0.3 + 0.1 * (double)si, ph = 0.9 * (double)si;
-        lp_vec3 w = vec(sin(th) * cos(ph), sin(th) * sin(ph), cos(th));
-        desc.axis = w;
-        desc.position = vec(-2.0 * (double)si, 1.0, 4.0);
-        if (lp_lens_create(&desc, &lens, &err) != LP_OK) {
-            CHECK(0, "%s: %s", shapes[si].name, err.message);
+        lp_vec3 u, v, w;
+        if (placed_lens(&shapes[si], si, &lens, &desc, &u, &v, &w) != 0)
             continue;
-        }
-        lp_lens_get_desc(lens, &desc);
-        lp_vec3 u = fabs(w.x) < 0.6 ? vec(1, 0, 0) : vec(0, 1, 0);
-        double uw = u.x * w.x + u.y * w.y + u.z * w.z;
-        u = vec(u.x - uw * w.x, u.y - uw * w.y, u.z - uw * w.z);
-        double ul = sqrt(u.x * u.x + u.y * u.y + u.z * u.z);
-        u = vec(u.x / ul, u.y / ul, u.z / ul);
-        lp_vec3 v = vec(w.y * u.z - w.z * u.y, w.z * u.x - w.x * u.z, w.x * u.y - w.y * u.x);
         double h = 0.5 * desc.diameter, t = desc.thickness;
         for (int ri = 0; ri < 36; ri++) {
             lp_vec3 o, d;
