@@ -22,9 +22,8 @@
  * renderer's bundles are mostly those), so that the way is read once for
  * both; a request of more rays takes more lanes, and an odd one's last
  * lane repeats its ray.  Each ray takes the one-ray code's operations in
- * their order (trace_backward.c: gather_one; gather_lanes.c's
- * gather_kernel is the same for one way, its steps on a complex field
- * those of interface.c and cvec3.h part by part), so its numbers are that
+ * their order (trace_backward.c: gather_one; the steps of ray_lanes.h,
+ * which gather_lanes.c takes along one way), so its numbers are that
  * code's bit for bit, and the outgoing rays are stored request by
  * request, ray by ray, as the gathers one by one store them.  A request
  * the lanes do not take -- a crystal lens, a way of normal incidence, a
@@ -36,9 +35,11 @@
 #include "backward.h"
 #include "error.h"
 #include "lanes.h"
+#include "ray_lanes.h"
 
 /* Lanes per group. */
 #define GM 8
+_Static_assert(GM <= LP__RAY_LANES, "a group's rays fit lp__ray_lanes");
 
 /* A loop over the lanes of a group (lanes.h). */
 #define GM_LANES(i) LP__LANE_LOOP(i, GM)
@@ -70,24 +71,6 @@ typedef struct gm_lanes {
     double fa[GM_DEPTH + 1][GM], fb[GM_DEPTH + 1][GM];
     double fc[GM_DEPTH + 1][GM], fd[GM_DEPTH + 1][GM]; /* imaginary parts of rs, rp */
     double sa[GM_DEPTH + 1][GM], st[GM_DEPTH + 1][GM];
-    /* per ray h of the lane */
-    double vx[2][GM], vy[2][GM], vz[2][GM]; /* in: world field directions */
-    double in[2][GM];                       /* in: intensities */
-    double ok[2][GM];                       /* 1: the field direction checks out */
-    double ex[2][GM], ey[2][GM], ez[2][GM]; /* the field, local (its real part) */
-    double fx[2][GM], fy[2][GM], fz[2][GM]; /* its imaginary part, once complex */
-    double odd[2][GM];                      /* 1: it turned real again (one by one) */
-    double ab[2][GM];                       /* power absorbed in the glass */
-    double fl[2][GM];                       /* phase jumps counted */
-    double pw[2][GM];                       /* out: the power leaving */
-    double wx[2][GM], wy[2][GM], wz[2][GM]; /* out: its world field direction */
-    /* a complex field's split (lp__field_split_elliptic): the square
-     * E.E, the ellipse's phase psi and exp(-i psi); out: the parts (0, 1
-     * or 2), the second one's power and world field direction */
-    double qr[2][GM], qi[2][GM], psi[2][GM], hr[2][GM], hi[2][GM];
-    double np[2][GM];
-    double pw1[2][GM];
-    double wx1[2][GM], wy1[2][GM], wz1[2][GM];
 } gm_lanes;
 
 /* The light's step at node j of a way of depth k: 1 a reflection (off
@@ -99,179 +82,39 @@ static int reflects(int j, int k)
     return j == k ? k == 1 : j > 1;
 }
 
-/* lp__bundle_ray_check of ray h of lane i (the local field direction,
- * perpendicular to the light), then its amplitude. */
-LP__INLINE void gm_start(gm_lanes *restrict L, int h, int i, lp_vec3 u, lp_vec3 v, lp_vec3 w,
-                         lp_vec3 light)
+/* Node j's axes of lane i: its s and p, the branch's p. */
+LP__INLINE void gm_axes(const gm_lanes *restrict L, int j, int i, lp_vec3 *s, lp_vec3 *p,
+                        lp_vec3 *ap)
 {
-    lp_vec3 b = v3(L->vx[h][i], L->vy[h][i], L->vz[h][i]);
-    lp_vec3 l = v3(v3_dot(b, u), v3_dot(b, v), v3_dot(b, w));
-    double ok;
-    lp_vec3 e = v3_scale(lp__perp_unit_core(l, light, &ok), sqrt(L->in[h][i]));
-    L->ok[h][i] = ok;
-    L->ex[h][i] = e.x, L->ey[h][i] = e.y, L->ez[h][i] = e.z;
-    L->fx[h][i] = L->fy[h][i] = L->fz[h][i] = 0.0;
-    L->odd[h][i] = 0.0;
-    L->ab[h][i] = 0.0;
-    L->fl[h][i] = 0.0;
+    *s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
+    *p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
+    *ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
 }
 
-/* Ray h of lane i over a segment (seg_abs sa, seg_att st). */
-LP__INLINE void gm_absorb(gm_lanes *restrict L, int h, int i, double sa, double st)
+/* Lane i's lens frame u, v, w and exit direction d. */
+LP__INLINE void gm_frame(const gm_lanes *restrict L, int i, lp_vec3 *u, lp_vec3 *v, lp_vec3 *w,
+                         lp_vec3 *d)
 {
-    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
-    L->ab[h][i] += v3_dot(e, e) * sa;
-    e = v3_scale(e, st);
-    L->ex[h][i] = e.x, L->ey[h][i] = e.y, L->ez[h][i] = e.z;
-}
-
-/* lp__node_reflect_real of ray h of lane i. */
-LP__INLINE void gm_reflect(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p, lp_vec3 ap,
-                           double rs, double rp)
-{
-    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
-    double es = v3_dot(e, s), ep = v3_dot(e, p);
-    int flip = rs * (es * es) - rp * (ep * ep) < 0.0;
-    double a = flip ? -rs : rs, c = flip ? -rp : rp;
-    e = v3_add(v3_scale(s, a * es), v3_scale(ap, c * ep));
-    L->ex[h][i] = e.x, L->ey[h][i] = e.y, L->ez[h][i] = e.z;
-    L->fl[h][i] += flip ? 1.0 : 0.0;
-}
-
-/* lp__node_transmit_real of ray h of lane i. */
-LP__INLINE void gm_transmit(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p,
-                            lp_vec3 ap, double ts, double tp)
-{
-    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
-    double es = v3_dot(e, s), ep = v3_dot(e, p);
-    e = v3_add(v3_scale(s, ts * es), v3_scale(ap, tp * ep));
-    L->ex[h][i] = e.x, L->ey[h][i] = e.y, L->ez[h][i] = e.z;
-}
-
-/* lp__field_split_real and lp__emit_linear of ray h of lane i: the power
- * and the world field direction of the ray leaving along the local d. */
-LP__INLINE void gm_leave(gm_lanes *restrict L, int h, int i, lp_vec3 d, lp_vec3 u, lp_vec3 v,
-                         lp_vec3 w)
-{
-    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
-    lp_vec3 c = lp__unit_perp(e, d);
-    lp_vec3 o = v3_add(v3_add(v3_scale(u, c.x), v3_scale(v, c.y)), v3_scale(w, c.z));
-    L->pw[h][i] = v3_dot(e, e);
-    L->wx[h][i] = o.x, L->wy[h][i] = o.y, L->wz[h][i] = o.z;
-}
-
-/* The steps on a complex field, gather_lanes.c's (gl_*) for ray h of
- * lane i. */
-
-/* cv3_norm2, cv3_scale_real over a segment. */
-LP__INLINE void gmc_absorb(gm_lanes *restrict L, int h, int i, double sa, double st)
-{
-    double n2 = L->ex[h][i] * L->ex[h][i] + L->fx[h][i] * L->fx[h][i] +
-                L->ey[h][i] * L->ey[h][i] + L->fy[h][i] * L->fy[h][i] +
-                L->ez[h][i] * L->ez[h][i] + L->fz[h][i] * L->fz[h][i];
-    L->ab[h][i] += n2 * sa;
-    L->ex[h][i] *= st, L->ey[h][i] *= st, L->ez[h][i] *= st;
-    L->fx[h][i] *= st, L->fy[h][i] *= st, L->fz[h][i] *= st;
-}
-
-/* lp__node_project on the axes s, p (gl_project): a real field (cplx 0)
- * has real amplitudes; a complex one whose imaginary part is zero is
- * marked odd. */
-LP__INLINE void gmc_project(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p, int cplx,
-                            double *esr, double *esi, double *epr, double *epi)
-{
-    lp_vec3 e = v3(L->ex[h][i], L->ey[h][i], L->ez[h][i]);
-    lp_vec3 f = v3(L->fx[h][i], L->fy[h][i], L->fz[h][i]);
-    *esr = v3_dot(e, s), *epr = v3_dot(e, p);
-    if (cplx) {
-        *esi = v3_dot(f, s), *epi = v3_dot(f, p);
-        L->odd[h][i] += (f.x == 0.0) & (f.y == 0.0) & (f.z == 0.0) ? 1.0 : 0.0;
-    } else {
-        *esi = 0.0, *epi = 0.0;
-    }
-}
-
-/* The field after a node, a s + b pr (gl_combine: cv3_combine). */
-LP__INLINE void gmc_combine(gm_lanes *restrict L, int h, int i, double ar, double ai, lp_vec3 s,
-                            double br, double bi, lp_vec3 pr)
-{
-    L->ex[h][i] = ar * s.x + br * pr.x, L->fx[h][i] = ai * s.x + bi * pr.x;
-    L->ey[h][i] = ar * s.y + br * pr.y, L->fy[h][i] = ai * s.y + bi * pr.y;
-    L->ez[h][i] = ar * s.z + br * pr.z, L->fz[h][i] = ai * s.z + bi * pr.z;
-}
-
-/* reflect_on with the complex rs = (rs, rsi), rp = (rp, rpi) (gl_reflect). */
-LP__INLINE void gmc_reflect(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p, lp_vec3 ap,
-                            double rs, double rsi, double rp, double rpi, int cplx)
-{
-    double esr, esi, epr, epi;
-    gmc_project(L, h, i, s, p, cplx, &esr, &esi, &epr, &epi);
-    double mirror = rs * (esr * esr + esi * esi) - rp * (epr * epr + epi * epi);
-    int flip = mirror < 0.0;
-    double a = flip ? -rs : rs, b = flip ? -rsi : rsi;
-    double c = flip ? -rp : rp, d = flip ? -rpi : rpi;
-    gmc_combine(L, h, i, a * esr - b * esi, a * esi + b * esr, s, c * epr - d * epi,
-                c * epi + d * epr, ap);
-    L->fl[h][i] += flip ? 1.0 : 0.0;
-}
-
-/* transmit_on of a complex field. */
-LP__INLINE void gmc_transmit(gm_lanes *restrict L, int h, int i, lp_vec3 s, lp_vec3 p,
-                             lp_vec3 ap, double ts, double tp)
-{
-    double esr, esi, epr, epi;
-    gmc_project(L, h, i, s, p, 1, &esr, &esi, &epr, &epi);
-    gmc_combine(L, h, i, ts * esr, ts * esi, s, tp * epr, tp * epi, ap);
-}
-
-/* gl_split's first and last steps for ray h of lane i: cv3_norm2,
- * cv3_is_real and E.E; then, psi and exp(-i psi) known, the parts. */
-LP__INLINE void gmc_square(gm_lanes *restrict L, int h, int i)
-{
-    double ex = L->ex[h][i], ey = L->ey[h][i], ez = L->ez[h][i];
-    double fx = L->fx[h][i], fy = L->fy[h][i], fz = L->fz[h][i];
-    L->pw[h][i] = ex * ex + fx * fx + ey * ey + fy * fy + ez * ez + fz * fz;
-    L->odd[h][i] += (fx == 0.0) & (fy == 0.0) & (fz == 0.0) ? 1.0 : 0.0;
-    L->qr[h][i] = (ex * ex - fx * fx) + (ey * ey - fy * fy) + (ez * ez - fz * fz);
-    L->qi[h][i] = (ex * fx + fx * ex) + (ey * fy + fy * ey) + (ez * fz + fz * ez);
-}
-
-LP__INLINE void gmc_parts(gm_lanes *restrict L, int h, int i, lp_vec3 d, lp_vec3 u, lp_vec3 v,
-                          lp_vec3 w)
-{
-    double ex = L->ex[h][i], ey = L->ey[h][i], ez = L->ez[h][i];
-    double fx = L->fx[h][i], fy = L->fy[h][i], fz = L->fz[h][i];
-    double hr = L->hr[h][i], hi = L->hi[h][i], total = L->pw[h][i];
-    int same = L->psi[h][i] == 0.0;
-    lp_vec3 a = v3(same ? ex : ex * hr - fx * hi, same ? ey : ey * hr - fy * hi,
-                   same ? ez : ez * hr - fz * hi);
-    lp_vec3 b = v3(same ? fx : ex * hi + fx * hr, same ? fy : ey * hi + fy * hr,
-                   same ? fz : ez * hi + fz * hr);
-    double ia = v3_dot(a, a), ib = v3_dot(b, b);
-    int one = ib <= 1e-20 * total;
-    lp_vec3 ca = lp__unit_perp(a, d), cb = lp__unit_perp(b, d);
-    lp_vec3 o = v3_add(v3_add(v3_scale(u, ca.x), v3_scale(v, ca.y)), v3_scale(w, ca.z));
-    lp_vec3 o1 = v3_add(v3_add(v3_scale(u, cb.x), v3_scale(v, cb.y)), v3_scale(w, cb.z));
-    L->np[h][i] = !(total > 0.0) ? 0.0 : (one ? 1.0 : 2.0);
-    L->pw[h][i] = one ? total : ia;
-    L->wx[h][i] = o.x, L->wy[h][i] = o.y, L->wz[h][i] = o.z;
-    L->pw1[h][i] = ib;
-    L->wx1[h][i] = o1.x, L->wy1[h][i] = o1.y, L->wz1[h][i] = o1.z;
+    *u = v3(L->ux[i], L->uy[i], L->uz[i]);
+    *v = v3(L->wvx[i], L->wvy[i], L->wvz[i]);
+    *w = v3(L->wwx[i], L->wwy[i], L->wwz[i]);
+    *d = v3(L->dx[i], L->dy[i], L->dz[i]);
 }
 
 /* Every lane's two rays through its way of depth k (all lanes alike),
  * its field complex below node jc (0: real all the way), absorbing on
- * the segments where absorbs: gather_kernel's steps; the lanes from g on
- * (repeating lane 0) are not split (psi 0). */
-LP__WIDE static void gm_kernel(gm_lanes *restrict L, int k, int jc, int absorbs, int g)
+ * the segments where absorbs: gather_lanes.c's steps (ray_lanes.h), each
+ * lane reading its own way; the lanes from g on (repeating lane 0) are
+ * not split (psi 0). */
+LP__WIDE static void gm_kernel(const gm_lanes *restrict L, lp__ray_lanes *restrict R0,
+                               lp__ray_lanes *restrict R1, int k, int jc, int absorbs, int g)
 {
     GM_LANES(i) {
-        lp_vec3 u = v3(L->ux[i], L->uy[i], L->uz[i]);
-        lp_vec3 v = v3(L->wvx[i], L->wvy[i], L->wvz[i]);
-        lp_vec3 w = v3(L->wwx[i], L->wwy[i], L->wwz[i]);
+        lp_vec3 u, v, w, d;
+        gm_frame(L, i, &u, &v, &w, &d);
         lp_vec3 light = v3(L->lx[i], L->ly[i], L->lz[i]);
-        gm_start(L, 0, i, u, v, w, light);
-        gm_start(L, 1, i, u, v, w, light);
+        lp__rl_start(R0, i, u, v, w, light);
+        lp__rl_start(R1, i, u, v, w, light);
     }
     /* the way, in the light's direction: way_step_real while the field is
      * real (j > jc), way_step on a complex one */
@@ -280,94 +123,78 @@ LP__WIDE static void gm_kernel(gm_lanes *restrict L, int k, int jc, int absorbs,
         if (j < k && absorbs) { /* over the segment from node j + 1 */
             if (cplx)
                 GM_LANES(i) {
-                    gmc_absorb(L, 0, i, L->sa[j][i], L->st[j][i]);
-                    gmc_absorb(L, 1, i, L->sa[j][i], L->st[j][i]);
+                    lp__rl_absorb_complex(R0, i, L->sa[j][i], L->st[j][i]);
+                    lp__rl_absorb_complex(R1, i, L->sa[j][i], L->st[j][i]);
                 }
             else
                 GM_LANES(i) {
-                    gm_absorb(L, 0, i, L->sa[j][i], L->st[j][i]);
-                    gm_absorb(L, 1, i, L->sa[j][i], L->st[j][i]);
+                    lp__rl_absorb(R0, i, L->sa[j][i], L->st[j][i]);
+                    lp__rl_absorb(R1, i, L->sa[j][i], L->st[j][i]);
                 }
         }
         if (j <= jc && reflects(j, k)) { /* lp__node_project, reflect_on, complex */
             if (cplx)
                 GM_LANES(i) {
-                    lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
-                    lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
-                    lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
+                    lp_vec3 s, p, ap;
+                    gm_axes(L, j, i, &s, &p, &ap);
                     double rs = L->fa[j][i], rp = L->fb[j][i];
                     double rsi = L->fc[j][i], rpi = L->fd[j][i];
-                    gmc_reflect(L, 0, i, s, p, ap, rs, rsi, rp, rpi, 1);
-                    gmc_reflect(L, 1, i, s, p, ap, rs, rsi, rp, rpi, 1);
+                    lp__rl_reflect_complex(R0, i, s, p, ap, rs, rsi, rp, rpi, 1);
+                    lp__rl_reflect_complex(R1, i, s, p, ap, rs, rsi, rp, rpi, 1);
                 }
             else
                 GM_LANES(i) {
-                    lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
-                    lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
-                    lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
+                    lp_vec3 s, p, ap;
+                    gm_axes(L, j, i, &s, &p, &ap);
                     double rs = L->fa[j][i], rp = L->fb[j][i];
                     double rsi = L->fc[j][i], rpi = L->fd[j][i];
-                    gmc_reflect(L, 0, i, s, p, ap, rs, rsi, rp, rpi, 0);
-                    gmc_reflect(L, 1, i, s, p, ap, rs, rsi, rp, rpi, 0);
+                    lp__rl_reflect_complex(R0, i, s, p, ap, rs, rsi, rp, rpi, 0);
+                    lp__rl_reflect_complex(R1, i, s, p, ap, rs, rsi, rp, rpi, 0);
                 }
         } else if (j <= jc) { /* lp__node_project, transmit_on, complex */
             GM_LANES(i) {
-                lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
-                lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
-                lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
-                gmc_transmit(L, 0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
-                gmc_transmit(L, 1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                lp_vec3 s, p, ap;
+                gm_axes(L, j, i, &s, &p, &ap);
+                lp__rl_transmit_complex(R0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                lp__rl_transmit_complex(R1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
             }
         } else if (reflects(j, k)) { /* lp__node_reflect_real */
             GM_LANES(i) {
-                lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
-                lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
-                lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
-                gm_reflect(L, 0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
-                gm_reflect(L, 1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                lp_vec3 s, p, ap;
+                gm_axes(L, j, i, &s, &p, &ap);
+                lp__rl_reflect(R0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                lp__rl_reflect(R1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
             }
         } else { /* lp__node_transmit_real */
             GM_LANES(i) {
-                lp_vec3 s = v3(L->sx[j][i], L->sy[j][i], L->sz[j][i]);
-                lp_vec3 p = v3(L->px[j][i], L->py[j][i], L->pz[j][i]);
-                lp_vec3 ap = v3(L->ax[j][i], L->ay[j][i], L->az[j][i]);
-                gm_transmit(L, 0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
-                gm_transmit(L, 1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                lp_vec3 s, p, ap;
+                gm_axes(L, j, i, &s, &p, &ap);
+                lp__rl_transmit(R0, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
+                lp__rl_transmit(R1, i, s, p, ap, L->fa[j][i], L->fb[j][i]);
             }
         }
     }
-    if (jc > 0) { /* lp__field_split of a complex field (gl_split) */
+    if (jc > 0) { /* lp__field_split of a complex field */
         GM_LANES(i) {
-            gmc_square(L, 0, i);
-            gmc_square(L, 1, i);
+            lp__rl_square(R0, i);
+            lp__rl_square(R1, i);
         }
         for (int i = 0; i < GM; i++)
-            for (int h = 0; h < 2; h++) {
-                double psi = 0.0;
-                double complex e = 1.0;
-                if (i < g) { /* the lanes in use: the phase lane by lane */
-                    psi = lp__ellipse_psi(CMPLX(L->qr[h][i], L->qi[h][i]));
-                    e = psi == 0.0 ? 1.0 : lp__phasor_minus(psi);
-                }
-                L->psi[h][i] = psi, L->hr[h][i] = creal(e), L->hi[h][i] = cimag(e);
-            }
+            for (int h = 0; h < 2; h++)
+                lp__rl_phase(h ? R1 : R0, i, i < g);
         GM_LANES(i) {
-            lp_vec3 d = v3(L->dx[i], L->dy[i], L->dz[i]);
-            lp_vec3 u = v3(L->ux[i], L->uy[i], L->uz[i]);
-            lp_vec3 v = v3(L->wvx[i], L->wvy[i], L->wvz[i]);
-            lp_vec3 w = v3(L->wwx[i], L->wwy[i], L->wwz[i]);
-            gmc_parts(L, 0, i, d, u, v, w);
-            gmc_parts(L, 1, i, d, u, v, w);
+            lp_vec3 u, v, w, d;
+            gm_frame(L, i, &u, &v, &w, &d);
+            lp__rl_parts(R0, i, d, u, v, w);
+            lp__rl_parts(R1, i, d, u, v, w);
         }
         return;
     }
     GM_LANES(i) {
-        lp_vec3 d = v3(L->dx[i], L->dy[i], L->dz[i]);
-        lp_vec3 u = v3(L->ux[i], L->uy[i], L->uz[i]);
-        lp_vec3 v = v3(L->wvx[i], L->wvy[i], L->wvz[i]);
-        lp_vec3 w = v3(L->wwx[i], L->wwy[i], L->wwz[i]);
-        gm_leave(L, 0, i, d, u, v, w);
-        gm_leave(L, 1, i, d, u, v, w);
+        lp_vec3 u, v, w, d;
+        gm_frame(L, i, &u, &v, &w, &d);
+        lp__rl_leave(R0, i, d, u, v, w);
+        lp__rl_leave(R1, i, d, u, v, w);
     }
 }
 
@@ -414,18 +241,18 @@ LP__INLINE void way_in(gm_lanes *L, int i, int j, const lp__bw_way *w, int im)
 /* Lane i of L takes query q of bw (in_lanes; its field complex below
  * node jc, absorbing where absorbs) and its rays b[0] and b[1] (b[0]
  * twice where two is 0): what gm_kernel reads of them. */
-LP__INLINE void lane_in(gm_lanes *L, int i, const lp_backward *bw, size_t q, const lp_ray *b,
-                        int two, int jc, int absorbs)
+LP__INLINE void lane_in(gm_lanes *L, lp__ray_lanes *R, int i, const lp_backward *bw, size_t q,
+                        const lp_ray *b, int two, int jc, int absorbs)
 {
     const lp_lens *lens = bw->lens;
     const int k = bw->query[q].depth;
     const lp__bw_way *entry = &bw->entry[q];
     const lp_vec3 light = entry->node.d, d = bw->exit.d;
     const lp_ray *b1 = two ? b + 1 : b;
-    L->vx[0][i] = b->vp.x, L->vy[0][i] = b->vp.y, L->vz[0][i] = b->vp.z;
-    L->in[0][i] = b->intensity;
-    L->vx[1][i] = b1->vp.x, L->vy[1][i] = b1->vp.y, L->vz[1][i] = b1->vp.z;
-    L->in[1][i] = b1->intensity;
+    R[0].vx[i] = b->vp.x, R[0].vy[i] = b->vp.y, R[0].vz[i] = b->vp.z;
+    R[0].in[i] = b->intensity;
+    R[1].vx[i] = b1->vp.x, R[1].vy[i] = b1->vp.y, R[1].vz[i] = b1->vp.z;
+    R[1].in[i] = b1->intensity;
     L->lx[i] = light.x, L->ly[i] = light.y, L->lz[i] = light.z;
     L->dx[i] = d.x, L->dy[i] = d.y, L->dz[i] = d.z;
     L->ux[i] = lens->u.x, L->uy[i] = lens->u.y, L->uz[i] = lens->u.z;
@@ -465,33 +292,33 @@ typedef struct gm_window {
 
 /* Run the g lanes of group `key` filled, the lanes past g repeating the
  * first, and keep what leaves at the rays' places. */
-static void run_group(gm_window *W, gm_lanes *L, int g, int key, const lp_backward *const *bw,
-                      const size_t *q, const lp_ray *const *bundle)
+static void run_group(gm_window *W, gm_lanes *L, lp__ray_lanes *R, int g, int key,
+                      const lp_backward *const *bw, const size_t *q, const lp_ray *const *bundle)
 {
     int jc = (key >> 1) % (GM_DEPTH + 1);
     for (int i = g; i < GM; i++)
-        lane_in(L, i, bw[W->k0], q[W->k0], &bundle[W->k0][W->i0], W->two[0], jc, key & 1);
-    gm_kernel(L, (key >> 1) / (GM_DEPTH + 1), jc, key & 1, g);
+        lane_in(L, R, i, bw[W->k0], q[W->k0], &bundle[W->k0][W->i0], W->two[0], jc, key & 1);
+    gm_kernel(L, &R[0], &R[1], (key >> 1) / (GM_DEPTH + 1), jc, key & 1, g);
     for (int i = 0; i < g; i++)
         for (int h = 0; h <= W->two[i]; h++) {
             size_t t = W->at[i] + (size_t)h;
-            W->bad[W->req[i]] |= (L->ok[h][i] == 0.0) | (L->odd[h][i] != 0.0);
-            W->pw[t] = L->pw[h][i];
-            W->ab[t] = L->ab[h][i];
-            W->fl[t] = L->fl[h][i];
-            W->wx[t] = L->wx[h][i], W->wy[t] = L->wy[h][i], W->wz[t] = L->wz[h][i];
+            W->bad[W->req[i]] |= (R[h].ok[i] == 0.0) | (R[h].odd[i] != 0.0);
+            W->pw[t] = R[h].pw[i];
+            W->ab[t] = R[h].ab[i];
+            W->fl[t] = R[h].fl[i];
+            W->wx[t] = R[h].wx[i], W->wy[t] = R[h].wy[i], W->wz[t] = R[h].wz[i];
             if (jc > 0) {
-                W->np[t] = L->np[h][i];
-                W->pw1[t] = L->pw1[h][i];
-                W->psi[t] = L->psi[h][i];
-                W->wx1[t] = L->wx1[h][i], W->wy1[t] = L->wy1[h][i], W->wz1[t] = L->wz1[h][i];
+                W->np[t] = R[h].np[i];
+                W->pw1[t] = R[h].pw1[i];
+                W->psi[t] = R[h].psi[i];
+                W->wx1[t] = R[h].wx1[i], W->wy1[t] = R[h].wy1[i], W->wz1[t] = R[h].wz1[i];
             }
         }
 }
 
 /* Gather the rays of requests k0 .. k0+m the lanes take, group by group,
  * GM lanes at a time, two rays a lane. */
-static void run_window(gm_window *W, gm_lanes *L, size_t k0, size_t m,
+static void run_window(gm_window *W, gm_lanes *L, lp__ray_lanes *R, size_t k0, size_t m,
                        const lp_backward *const *bw, const size_t *q,
                        const lp_ray *const *bundle, const size_t *n)
 {
@@ -521,7 +348,7 @@ static void run_window(gm_window *W, gm_lanes *L, size_t k0, size_t m,
         size_t r = (size_t)W->order[o], k = k0 + r;
         if (W->key[r] != key) {
             if (g > 0)
-                run_group(W, L, g, key, bw, q, bundle);
+                run_group(W, L, R, g, key, bw, q, bundle);
             g = 0;
             key = W->key[r];
             jc = (key >> 1) % (GM_DEPTH + 1), absorbs = key & 1;
@@ -530,18 +357,18 @@ static void run_window(gm_window *W, gm_lanes *L, size_t k0, size_t m,
             int two = i + 1 < n[k];
             if (g == 0)
                 W->k0 = k, W->i0 = i;
-            lane_in(L, g, bw[k], q[k], &bundle[k][i], two, jc, absorbs);
+            lane_in(L, R, g, bw[k], q[k], &bundle[k][i], two, jc, absorbs);
             W->at[g] = W->ray[r] + i;
             W->req[g] = r;
             W->two[g] = two;
             if (++g == GM) {
-                run_group(W, L, g, key, bw, q, bundle);
+                run_group(W, L, R, g, key, bw, q, bundle);
                 g = 0;
             }
         }
     }
     if (g > 0)
-        run_group(W, L, g, key, bw, q, bundle);
+        run_group(W, L, R, g, key, bw, q, bundle);
 }
 
 /* Store request r's rays, from place t of the window, into out as
@@ -585,6 +412,7 @@ lp_status lp_backward_gather_many(const lp_backward *const *bw, const size_t *q,
 {
     gm_window W;
     gm_lanes L;
+    lp__ray_lanes R[2]; /* the lanes' two rays */
 
     if (!out || (count > 0 && (!bw || !q || !bundle || !n)))
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_gather_many: NULL argument");
@@ -608,7 +436,7 @@ lp_status lp_backward_gather_many(const lp_backward *const *bw, const size_t *q,
             m++;
         }
         if (rays > 0)
-            run_window(&W, &L, k0, m, bw, q, bundle, n);
+            run_window(&W, &L, R, k0, m, bw, q, bundle, n);
         /* the window's requests in order: from the lanes where every ray's
          * field direction checked out (and no complex field turned real),
          * else by lp_backward_gather */
