@@ -636,10 +636,14 @@ LP_API lp_status lp_backward_gather(const lp_backward *bw, size_t q,
  * "request k: ", out holds what gathers 0 .. k-1 appended and what gather
  * k appended before it failed (from start[k] on), and requests k+1 ..
  * count-1 are not gathered (start[k+1 ..) not set): a caller that wants
- * them calls again from k + 1.  count = 0 does nothing and returns LP_OK.
- * A NULL out, or a NULL bw, q, bundle or n when count > 0, gives
- * LP_ERROR_INVALID_ARGUMENT before any gather; a NULL bw[k], or a NULL
- * bundle[k] with n[k] > 0, fails gather k as lp_backward_gather does. */
+ * them calls again from k + 1.  Every request's arguments must be valid
+ * to read even after one that fails: they are read ahead, up to 256
+ * requests at a time.  start must not overlap bw, q or n, and no bundle
+ * may lie in out->rays.  count = 0 with a non-NULL out does nothing and
+ * returns LP_OK.  A NULL out, or a NULL bw, q, bundle or n when
+ * count > 0, gives LP_ERROR_INVALID_ARGUMENT before any gather; a NULL
+ * bw[k], or a NULL bundle[k] with n[k] > 0, fails gather k as
+ * lp_backward_gather does.  The call takes about 46 KB of stack. */
 LP_API lp_status lp_backward_gather_many(const lp_backward *const *bw, const size_t *q,
                                          const lp_ray *const *bundle, const size_t *n,
                                          size_t count, lp_result *out, size_t *start,

@@ -90,14 +90,6 @@ LP__WIDE static void gather_kernel(lp__ray_lanes *restrict L, const lp_backward 
     GL_LANES(i) lp__rl_leave(L, i, exit_d, u, v, w);
 }
 
-/* Whether a bundle ray passes the checks of lp__bundle_ray_check that
- * come before its field direction's. */
-static int ray_fine(const lp_ray *b)
-{
-    return isfinite(b->intensity) && !(b->intensity < 0.0) && isfinite(b->op) &&
-           isfinite(b->phase) && v3_finite(b->vp);
-}
-
 size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
                         lp_result *res, lp_status *st, lp_error *err)
 {
@@ -110,7 +102,7 @@ size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, s
         size_t m = n - done < GL ? n - done : GL;
         const lp_ray *b = bundle + done;
         for (size_t i = 0; i < m; i++)
-            if (!ray_fine(&b[i])) {
+            if (!lp__ray_fine(&b[i])) {
                 m = i; /* ray i and the rest one by one: that reports ray i */
                 break;
             }

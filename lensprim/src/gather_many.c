@@ -198,14 +198,6 @@ LP__WIDE static void gm_kernel(const gm_lanes *restrict L, lp__ray_lanes *restri
     }
 }
 
-/* Whether a bundle ray passes the checks of lp__bundle_ray_check that
- * come before its field direction's (gather_lanes.c's). */
-static int ray_fine(const lp_ray *b)
-{
-    return isfinite(b->intensity) && !(b->intensity < 0.0) && isfinite(b->op) &&
-           isfinite(b->phase) && v3_finite(b->vp);
-}
-
 /* Whether the lanes take request (bw, q, bundle[0..n)): a polarized
  * build's query (its ways set up) whose way lanes take (complex_at >= 0),
  * not too deep, its rays fine and few enough. */
@@ -216,7 +208,7 @@ static int in_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_
         bw->complex_at[q] < 0 || bw->query[q].depth > GM_DEPTH)
         return 0;
     for (size_t i = 0; i < n; i++)
-        if (!ray_fine(&bundle[i]))
+        if (!lp__ray_fine(&bundle[i]))
             return 0;
     return 1;
 }

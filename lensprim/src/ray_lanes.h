@@ -52,6 +52,15 @@ typedef struct lp__ray_lanes {
     double wx1[LP__RAY_LANES], wy1[LP__RAY_LANES], wz1[LP__RAY_LANES];
 } lp__ray_lanes;
 
+/* Whether a bundle ray passes the checks of lp__bundle_ray_check that
+ * come before its field direction's (a ray that does not is left to the
+ * one-ray code, which reports it). */
+static inline int lp__ray_fine(const lp_ray *b)
+{
+    return isfinite(b->intensity) && !(b->intensity < 0.0) && isfinite(b->op) &&
+           isfinite(b->phase) && v3_finite(b->vp);
+}
+
 /* lp__bundle_ray_check of lane i's ray (its local field direction,
  * perpendicular to the light; lens frame u, v, w), then its amplitude;
  * the counts start at 0. */

@@ -1800,6 +1800,20 @@ static int gather_shared(rs_worker *w, frame *fr, size_t j, int split, int batch
 static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_vec3 d,
                           const rs_hit *hit, int level, double weight, int f, bundle *out);
 
+/* realloc of the array whose pointer is at pp (of any object type, read
+ * and written as bytes: no lvalue of another type) to n elements of
+ * size; it is left as it was when that fails.  Returns -1 then. */
+static int grow(void *pp, size_t n, size_t size)
+{
+    void *old, *p;
+    memcpy(&old, pp, sizeof old);
+    p = realloc(old, n * size);
+    if (!p)
+        return -1;
+    memcpy(pp, &p, sizeof p);
+    return 0;
+}
+
 /* Room in fr for n gathers of gather_all (the bundles kept from one lens
  * hit to the next).  Returns -1 when out of memory. */
 static int gather_room(frame *fr, size_t n)
@@ -1815,16 +1829,13 @@ static int gather_room(frame *fr, size_t n)
     }
     if (n > fr->gm_cap) {
         size_t cap = 2 * fr->gm_cap > n ? 2 * fr->gm_cap : n;
-        void **arr[6] = {(void **)&fr->gm_bw, (void **)&fr->gm_b, (void **)&fr->gm_q,
-                         (void **)&fr->gm_n, (void **)&fr->gm_start, (void **)&fr->gm_lane};
-        size_t size[6] = {sizeof *fr->gm_bw, sizeof *fr->gm_b, sizeof *fr->gm_q,
-                          sizeof *fr->gm_n, sizeof *fr->gm_start, sizeof *fr->gm_lane};
-        for (int k = 0; k < 6; k++) {
-            void *p = realloc(*arr[k], cap * size[k]);
-            if (!p)
-                return -1;
-            *arr[k] = p;
-        }
+        if (grow(&fr->gm_bw, cap, sizeof *fr->gm_bw) != 0 ||
+            grow(&fr->gm_b, cap, sizeof *fr->gm_b) != 0 ||
+            grow(&fr->gm_q, cap, sizeof *fr->gm_q) != 0 ||
+            grow(&fr->gm_n, cap, sizeof *fr->gm_n) != 0 ||
+            grow(&fr->gm_start, cap, sizeof *fr->gm_start) != 0 ||
+            grow(&fr->gm_lane, cap, sizeof *fr->gm_lane) != 0)
+            return -1;
         fr->gm_cap = cap;
     }
     return 0;
@@ -1884,10 +1895,17 @@ static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, doub
     for (size_t from = 0; from < nr;) {
         for (size_t k = from; k < nr; k++)
             fr->gm_start[k] = SIZE_MAX;
+        size_t before = fr->res.count;
         if (lp_backward_gather_many(fr->gm_bw + from, fr->gm_q + from, fr->gm_b + from,
                                     fr->gm_n + from, nr - from, &fr->res, fr->gm_start + from,
                                     NULL) == LP_OK)
             break;
+        if (fr->gm_start[from] == SIZE_MAX) { /* failed before any gather: none of the rest */
+            fr->res.count = before;
+            for (size_t k = from; k < nr; k++)
+                fr->gm_start[k] = before;
+            break;
+        }
         size_t k = from;
         while (k + 1 < nr && fr->gm_start[k + 1] != SIZE_MAX)
             k++;

@@ -19,6 +19,8 @@ typedef struct placed_shape {
     double n;
     const char *medium; /* catalog medium, or NULL: air */
     int crystal;        /* 1: a uniaxial crystal (constant indices) */
+    double tau10;       /* > 0: the glass absorbs, this internal
+                           transmittance per 10 mm at every wavelength */
 } placed_shape;
 
 static inline lp_vec3 vec(double x, double y, double z)
@@ -56,6 +58,12 @@ static inline int placed_lens(const placed_shape *s, size_t si, lp_lens **lens,
         CHECK(lp_glass_builtin(s->glass, &desc->glass, &err) == LP_OK, "%s", err.message);
     } else {
         lp_glass_init_constant(&desc->glass, s->n);
+    }
+    if (s->tau10 > 0.0) {
+        desc->glass.n_tau = 2;
+        desc->glass.tau_lambda_nm[0] = 380.0, desc->glass.tau_lambda_nm[1] = 780.0;
+        desc->glass.tau[0] = desc->glass.tau[1] = s->tau10;
+        desc->glass.tau_thickness_mm = 10.0;
     }
     if (s->medium)
         CHECK(lp_glass_builtin(s->medium, &desc->medium, &err) == LP_OK, "%s", err.message);

@@ -183,13 +183,13 @@ static void identity_case(const char *name, const lp_lens *lens, lp_vec3 o, lp_v
 static void test_identity(void)
 {
     const placed_shape shapes[] = {
-        {"biconvex N-BK7", 50, -50, 8, 25, 0, "N-BK7", 0, NULL, 0},
-        {"ball N-SF11", 10, -10, 19, 19.9, 0, "N-SF11", 0, NULL, 0},
-        {"meniscus F2 in CaF2", 20, 40, 4, 20, 0, "F2", 0, "CAF2", 0},
-        {"flat plate N-SF6", 0, 0, 3, 20, 0, "N-SF6", 0, NULL, 0},
-        {"conical rim n=1.6", 60, -30, 6, 24, 18, NULL, 1.6, NULL, 0},
-        {"knife edge n=1.5", 20, -20, 2 * (20 - sqrt(400 - 100)), 20, 0, NULL, 1.5, NULL, 0},
-        {"crystal plate", 0, 0, 3, 20, 0, NULL, 0, NULL, 1},
+        {"biconvex N-BK7", 50, -50, 8, 25, 0, "N-BK7", 0, NULL, 0, 0},
+        {"ball N-SF11", 10, -10, 19, 19.9, 0, "N-SF11", 0, NULL, 0, 0},
+        {"meniscus F2 in CaF2", 20, 40, 4, 20, 0, "F2", 0, "CAF2", 0, 0},
+        {"flat plate N-SF6", 0, 0, 3, 20, 0, "N-SF6", 0, NULL, 0, 0},
+        {"conical rim n=1.6", 60, -30, 6, 24, 18, NULL, 1.6, NULL, 0, 0},
+        {"knife edge n=1.5", 20, -20, 2 * (20 - sqrt(400 - 100)), 20, 0, NULL, 1.5, NULL, 0, 0},
+        {"crystal plate", 0, 0, 3, 20, 0, NULL, 0, NULL, 1, 0},
     };
     const size_t counts[] = {1, 3, 16, 17, 40};
     const int depths[] = {1, 2, 5, 12};

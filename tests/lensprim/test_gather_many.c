@@ -174,13 +174,15 @@ static void gather_case(const char *name, size_t nb, const double *lambda, int i
 static void test_identity(void)
 {
     const placed_shape shapes[] = {
-        {"biconvex N-BK7", 50, -50, 8, 25, 0, "N-BK7", 0, NULL, 0},
-        {"ball N-SF11", 10, -10, 19, 19.9, 0, "N-SF11", 0, NULL, 0},
-        {"meniscus F2 in CaF2", 20, 40, 4, 20, 0, "F2", 0, "CAF2", 0},
-        {"flat plate N-SF6", 0, 0, 3, 20, 0, "N-SF6", 0, NULL, 0},
-        {"conical rim n=1.6", 60, -30, 6, 24, 18, NULL, 1.6, NULL, 0},
-        {"biconcave SF11", -30, 30, 3, 22, 0, "N-SF11", 0, NULL, 0},
-        {"crystal plate", 0, 0, 3, 20, 0, NULL, 0, NULL, 1},
+        {"biconvex N-BK7", 50, -50, 8, 25, 0, "N-BK7", 0, NULL, 0, 0},
+        {"ball N-SF11", 10, -10, 19, 19.9, 0, "N-SF11", 0, NULL, 0, 0},
+        /* absorbing where total internal reflection makes the field complex */
+        {"absorbing ball n=1.8", 10, -10, 19, 19.9, 0, NULL, 1.8, NULL, 0, 0.3},
+        {"meniscus F2 in CaF2", 20, 40, 4, 20, 0, "F2", 0, "CAF2", 0, 0},
+        {"flat plate N-SF6", 0, 0, 3, 20, 0, "N-SF6", 0, NULL, 0, 0},
+        {"conical rim n=1.6", 60, -30, 6, 24, 18, NULL, 1.6, NULL, 0, 0},
+        {"biconcave SF11", -30, 30, 3, 22, 0, "N-SF11", 0, NULL, 0, 0},
+        {"crystal plate", 0, 0, 3, 20, 0, NULL, 0, NULL, 1, 0},
     };
     const int depths[] = {1, 2, 5, 12, 16};
     lp_error err;
@@ -262,6 +264,64 @@ static void test_errors(void)
     lp_result_release(&r);
 }
 
+/* Calls longer than the lanes' window of requests (256 at a time): many
+ * one-ray and two-ray requests of 16 wavelengths' builds, in builder order
+ * and interleaved, with a bundle of 300 rays (more than a window holds:
+ * gathered one by one) among them; the same comparison as above. */
+static void test_windows(void)
+{
+    static lp_ray big[300];
+    const placed_shape ball = {"ball N-SF11", 10, -10, 19, 19.9, 0, "N-SF11", 0, NULL, 0, 0.5};
+    lp_lens_desc desc;
+    lp_lens *lens;
+    lp_vec3 u, v, w;
+    lp_error err;
+    static lp_result a, b;
+    if (placed_lens(&ball, 1, &lens, &desc, &u, &v, &w) != 0)
+        return;
+    double lambda[NW];
+    for (size_t k = 0; k < NW; k++)
+        lambda[k] = 400.0 + 20.0 * (double)k;
+    lp_trace_args args;
+    lp_trace_args_init(&args);
+    args.max_depth = 8;
+    lp_vec3 o = place(desc.position, u, v, w, 0.3 * desc.diameter, 0.1, -30.0);
+    CHECK(lp_backward_build_many(bws, NW, lens, o, w, lambda, &args, &err) == LP_OK,
+          "windows: build: %s", err.message);
+    size_t nq = lp_backward_query_count(bws[0]);
+    CHECK(nq > 0, "windows: the view ray has queries");
+    for (int pass = 0; pass < 2 && nq > 0; pass++) {
+        size_t count = 0;
+        for (size_t r = 0; count < MAX_REQ; r++) {
+            size_t s = pass ? r % NW : (r / nq) % NW, j = pass ? (r / NW) % nq : r % nq;
+            if (j >= lp_backward_query_count(bws[s]))
+                continue;
+            lp_vec3 qd = lp_backward_queries(bws[s])[j].dir;
+            size_t n = r % 3; /* none (one by one), one or two rays */
+            req_bw[count] = bws[s];
+            req_q[count] = j;
+            req_n[count] = n;
+            req_b[count] = rays[count];
+            for (size_t i = 0; i < n; i++)
+                rays[count][i] = bundle_ray(qd, lambda[s], 0);
+            if (count == 300) { /* past the first window: a bundle longer than one */
+                for (size_t i = 0; i < sizeof big / sizeof big[0]; i++)
+                    big[i] = bundle_ray(qd, lambda[s], 0);
+                req_b[count] = big;
+                req_n[count] = sizeof big / sizeof big[0];
+            }
+            count++;
+        }
+        lp_result_clear(&a);
+        lp_result_clear(&b);
+        CHECK(compare_from(pass ? "windows, interleaved" : "windows, builder by builder", 0,
+                           count, &a, &b) == count,
+              "windows: no request fails");
+        CHECK(a.count > 2 * MAX_REQ / 2, "windows: %zu outgoing rays", a.count);
+    }
+    lp_lens_destroy(lens);
+}
+
 int main(void)
 {
     lp_error err;
@@ -269,6 +329,7 @@ int main(void)
         if (lp_backward_create(&bws[k], &err) != LP_OK)
             return 1;
     test_identity();
+    test_windows();
     test_errors();
     for (int k = 0; k < NW; k++)
         lp_backward_destroy(bws[k]);
