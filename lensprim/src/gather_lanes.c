@@ -93,7 +93,6 @@ LP__WIDE static void gather_kernel(lp__ray_lanes *restrict L, const lp_backward 
 size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
                         lp_result *res, lp_status *st, lp_error *err)
 {
-    const lp_query *qr = &bw->query[q];
     lp__ray_lanes L;
     size_t done = 0;
 
@@ -117,33 +116,15 @@ size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, s
         for (size_t i = 0; i < m; i++) {
             if (L.ok[i] == 0.0 || L.odd[i] != 0.0)
                 return done; /* the field direction fails, or turns real: one by one */
-            lp__payload pl = {bw->optics.lambda_nm, b[i].kphi + (int)L.fl[i],
-                              b[i].op + qr->op, b[i].phase, b[i].ch};
-            double before = res->out;
-            res->in += L.in[i];
-            res->nodes += (size_t)qr->depth;
-            if (bw->complex_at[q] > 0) { /* lp__emit_gathered_parts of the split */
-                for (int t = 0; t < (int)L.np[i]; t++) {
-                    *st = lp__emit_ray(res, &bw->exit, &pl, qr->depth, qr->kind, qr->surface,
-                                       qr->path, qr->waves, t, t ? L.pw1[i] : L.pw[i],
-                                       t ? v3(L.wx1[i], L.wy1[i], L.wz1[i])
-                                         : v3(L.wx[i], L.wy[i], L.wz[i]),
-                                       t ? L.psi[i] + 0.5 * LP_PI : L.psi[i], err);
-                    if (*st != LP_OK)
-                        return done;
-                }
-                lp__gathered_rest(res, before, L.in[i], L.ab[i]);
-                done++;
-                continue;
-            }
-            if (L.pw[i] > 0.0) { /* lp__field_split_real: one part */
-                *st = lp__emit_ray(res, &bw->exit, &pl, qr->depth, qr->kind, qr->surface,
-                                   qr->path, qr->waves, 0, L.pw[i],
-                                   v3(L.wx[i], L.wy[i], L.wz[i]), 0.0, err);
-                if (*st != LP_OK)
-                    return done;
-            }
-            lp__gathered_rest(res, before, L.in[i], L.ab[i]);
+            if (bw->complex_at[q] > 0) /* split (lp__field_split_elliptic) */
+                *st = lp__rl_store(res, bw, q, &b[i], L.fl[i], L.ab[i], (int)L.np[i], L.pw[i],
+                                   v3(L.wx[i], L.wy[i], L.wz[i]), L.pw1[i],
+                                   v3(L.wx1[i], L.wy1[i], L.wz1[i]), L.psi[i], err);
+            else /* real: one part (lp__field_split_real) */
+                *st = lp__rl_store(res, bw, q, &b[i], L.fl[i], L.ab[i], L.pw[i] > 0.0, L.pw[i],
+                                   v3(L.wx[i], L.wy[i], L.wz[i]), 0.0, v3(0, 0, 0), 0.0, err);
+            if (*st != LP_OK)
+                return done;
             done++;
         }
     }

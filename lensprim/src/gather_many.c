@@ -368,32 +368,17 @@ static void run_window(gm_window *W, gm_lanes *L, lp__ray_lanes *R, size_t k0, s
 static lp_status store(const gm_window *W, size_t t, const lp_backward *bw, size_t q,
                        const lp_ray *b, size_t n, lp_result *out, lp_error *err)
 {
-    const lp_query *qr = &bw->query[q];
+    const int cx = bw->complex_at[q] > 0; /* split (lp__field_split_elliptic) */
     out->warnings |= bw->warnings;
     for (size_t i = 0; i < n; i++, t++) {
-        lp__payload pl = {bw->optics.lambda_nm, b[i].kphi + (int)W->fl[t], b[i].op + qr->op,
-                          b[i].phase, b[i].ch};
-        double before = out->out;
-        out->in += b[i].intensity;
-        out->nodes += (size_t)qr->depth;
-        if (bw->complex_at[q] > 0) { /* lp__emit_gathered_parts of the split */
-            for (int p = 0; p < (int)W->np[t]; p++) {
-                lp_status st = lp__emit_ray(
-                    out, &bw->exit, &pl, qr->depth, qr->kind, qr->surface, qr->path, qr->waves,
-                    p, p ? W->pw1[t] : W->pw[t],
-                    p ? v3(W->wx1[t], W->wy1[t], W->wz1[t]) : v3(W->wx[t], W->wy[t], W->wz[t]),
-                    p ? W->psi[t] + 0.5 * LP_PI : W->psi[t], err);
-                if (st != LP_OK)
-                    return st;
-            }
-        } else if (W->pw[t] > 0.0) { /* lp__field_split_real: one part */
-            lp_status st = lp__emit_ray(out, &bw->exit, &pl, qr->depth, qr->kind, qr->surface,
-                                        qr->path, qr->waves, 0, W->pw[t],
-                                        v3(W->wx[t], W->wy[t], W->wz[t]), 0.0, err);
-            if (st != LP_OK)
-                return st;
-        }
-        lp__gathered_rest(out, before, b[i].intensity, W->ab[t]);
+        lp_status st =
+            cx ? lp__rl_store(out, bw, q, &b[i], W->fl[t], W->ab[t], (int)W->np[t], W->pw[t],
+                              v3(W->wx[t], W->wy[t], W->wz[t]), W->pw1[t],
+                              v3(W->wx1[t], W->wy1[t], W->wz1[t]), W->psi[t], err)
+               : lp__rl_store(out, bw, q, &b[i], W->fl[t], W->ab[t], W->pw[t] > 0.0, W->pw[t],
+                              v3(W->wx[t], W->wy[t], W->wz[t]), 0.0, v3(0, 0, 0), 0.0, err);
+        if (st != LP_OK)
+            return st;
     }
     return LP_OK;
 }

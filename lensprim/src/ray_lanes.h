@@ -21,6 +21,7 @@
 #include <complex.h>
 #include <math.h>
 
+#include "backward.h"
 #include "lanes.h"
 #include "polarization.h"
 
@@ -250,6 +251,35 @@ LP__INLINE void lp__rl_parts(lp__ray_lanes *restrict R, int i, lp_vec3 d, lp_vec
     R->wx[i] = o.x, R->wy[i] = o.y, R->wz[i] = o.z;
     R->pw1[i] = ib;
     R->wx1[i] = o1.x, R->wy1[i] = o1.y, R->wz1[i] = o1.z;
+}
+
+/* A gathered bundle ray b of query q of bw stored in res as the one-ray
+ * code stores it (lp__emit_gathered_parts): its np parts leaving (the
+ * first of power pw along the world field direction w and phase psi, the
+ * second of power pw1 along w1 and phase psi + pi/2; a real field is one
+ * part of phase 0, or none where its power is not > 0), its phase jumps
+ * fl and the power ab its glass absorbed, the rest truncated.  What both
+ * gathers in lanes do with a lane's outcome. */
+LP__INLINE lp_status lp__rl_store(lp_result *res, const lp_backward *bw, size_t q,
+                                  const lp_ray *b, double fl, double ab, int np, double pw,
+                                  lp_vec3 w, double pw1, lp_vec3 w1, double psi, lp_error *err)
+{
+    const lp_query *qr = &bw->query[q];
+    lp__payload pl = {bw->optics.lambda_nm, b->kphi + (int)fl, b->op + qr->op, b->phase, b->ch};
+    double before = res->out;
+    lp_status st = LP_OK;
+    res->in += b->intensity;
+    res->nodes += (size_t)qr->depth;
+    if (np > 0)
+        st = lp__emit_ray(res, &bw->exit, &pl, qr->depth, qr->kind, qr->surface, qr->path,
+                          qr->waves, 0, pw, w, psi, err);
+    if (np > 1 && st == LP_OK)
+        st = lp__emit_ray(res, &bw->exit, &pl, qr->depth, qr->kind, qr->surface, qr->path,
+                          qr->waves, 1, pw1, w1, psi + 0.5 * LP_PI, err);
+    if (st != LP_OK)
+        return st;
+    lp__gathered_rest(res, before, b->intensity, ab);
+    return LP_OK;
 }
 
 #endif
