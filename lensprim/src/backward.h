@@ -106,15 +106,12 @@ void lp__backward_light_way(const lp_backward *bw, int j, lp__bw_way *w);
 size_t lp__gather_lanes(const lp_backward *bw, size_t q, const lp_ray *bundle, size_t n,
                         lp_result *res, lp_status *st, lp_error *err);
 
-/* Every query's entry way and the light's ways at nodes 1..deepest-1,
- * into bw->entry and bw->light: those of lp__backward_entry_way and
- * lp__backward_light_way, bit for bit, set up in lanes
- * (backward_ways.c). */
-void lp__backward_ways(lp_backward *bw, int deepest);
-
-/* lp__backward_ways of every bw[k] that sets up its ways
- * (lp__backward_sets_ways), to its deepest query, bit for bit: the
- * lanes' groups filled across the builds. */
+/* The ways of every bw[k] that sets up its ways (lp__backward_sets_ways):
+ * each query's entry way and the light's ways at nodes 1 .. deepest-1
+ * (deepest: its deepest query), into bw[k]->entry and bw[k]->light --
+ * those of lp__backward_entry_way and lp__backward_light_way, bit for bit
+ * -- set up in lanes (backward_ways.c), the groups filled across the
+ * builds. */
 void lp__backward_ways_many(lp_backward *const *bw, size_t n);
 
 #endif

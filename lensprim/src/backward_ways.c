@@ -160,22 +160,6 @@ LP__INLINE void lane_out(lp_backward *bw, size_t k, const wl_lanes *L, int i)
     w->reflect = L->refl[i] != 0.0;
 }
 
-void lp__backward_ways(lp_backward *bw, int deepest)
-{
-    size_t n = bw->n_queries + (size_t)(deepest > 1 ? deepest - 1 : 0);
-    wl_lanes L;
-    for (size_t k0 = 0; k0 < n; k0 += WL) {
-        int m = n - k0 < WL ? (int)(n - k0) : WL;
-        /* lanes past m repeat the first in a first group, and keep the
-         * last group's ways (set up for nothing) after it */
-        for (int i = 0; i < (k0 == 0 ? WL : m); i++)
-            lane_in(bw, k0 + (size_t)(i < m ? i : 0), &L, i);
-        ways_kernel(&L);
-        for (int i = 0; i < m; i++)
-            lane_out(bw, k0 + (size_t)i, &L, i);
-    }
-}
-
 void lp__backward_ways_many(lp_backward *const *bw, size_t n)
 {
     wl_lanes L;

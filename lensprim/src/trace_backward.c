@@ -126,7 +126,7 @@ int lp__backward_deepest(const lp_backward *bw)
     return deepest;
 }
 
-/* Once bw's ways are set up (lp__backward_ways): where each way's fields
+/* Once bw's ways are set up (lp__backward_ways_many): where each way's fields
  * turn complex, if the lanes take it: at[j] for the light's way from
  * node j - 1 down (-1: not in lanes; 0: the field stays real; else the
  * first node under total internal reflection), then each query's from
@@ -159,11 +159,7 @@ int lp__backward_sets_ways(const lp_backward *bw)
 /* The ways of every query of a polarized build (backward.h). */
 void lp__backward_built(lp_backward *bw)
 {
-    if (!lp__backward_sets_ways(bw))
-        return;
-    int deepest = lp__backward_deepest(bw);
-    lp__backward_ways(bw, deepest);
-    mark_ways(bw, deepest);
+    lp__backward_built_many(&bw, 1);
 }
 
 /* Those of many builds, set up in lanes across them (backward.h). */
