@@ -176,6 +176,7 @@ typedef struct frame {
     const lp_ray **gm_b;
     size_t *gm_q, *gm_n, *gm_start;
     int *gm_lane;
+    double *gm_power; /* the power each carries out (camera_power) */
     size_t gm_cap;
     /* A spectral packet's split at this level (n_lanes entries each). */
     int *lane, *pos;
@@ -192,6 +193,8 @@ struct rs_worker {
     frame *frames[RS_MAX_FRAMES];
     int *lane_all;       /* 0 .. n_lanes - 1 */
     double *lane_value;  /* a pixel's value per lane */
+    double *pixel_power; /* a pixel's power per lane that came without
+                            rays (camera_power), added to its rays' */
     bundle pixel;
     const lp_ray **one;  /* pixel's rays by lane (pol_values) */
     double *one_i;       /* and their intensities in that lane */
@@ -442,6 +445,7 @@ rs_worker *rs_worker_create(const rs_integrator *it)
     w->it = it;
     w->lane_all = calloc((size_t)it->n_lanes, sizeof *w->lane_all);
     w->lane_value = calloc((size_t)it->n_lanes, sizeof *w->lane_value);
+    w->pixel_power = calloc((size_t)it->n_lanes, sizeof *w->pixel_power);
     w->lane_at = calloc((size_t)it->n_lanes + 1, sizeof *w->lane_at);
     w->cc_n = RS_COLOUR_CACHE;
     while (w->cc_n > 1 && w->cc_n * (size_t)it->n_lanes > RS_COLOUR_CACHE_LANES)
@@ -450,7 +454,7 @@ rs_worker *rs_worker_create(const rs_integrator *it)
     w->cc_stamp = calloc((size_t)CC_KINDS * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_stamp);
     w->cc_half = calloc((size_t)CC_HALVES * w->cc_n * (size_t)it->n_lanes, sizeof *w->cc_half);
     w->cc_half_has = calloc((size_t)CC_HALVES * w->cc_n * (size_t)it->n_lanes, 1);
-    if (!w->lane_all || !w->lane_value || !w->lane_at || !w->cc_val || !w->cc_stamp ||
+    if (!w->lane_all || !w->lane_value || !w->pixel_power || !w->lane_at || !w->cc_val || !w->cc_stamp ||
         !w->cc_half || !w->cc_half_has) {
         rs_worker_destroy(w);
         return NULL;
@@ -498,6 +502,7 @@ static void frame_free(frame *fr)
     free(fr->gm_n);
     free(fr->gm_start);
     free(fr->gm_lane);
+    free(fr->gm_power);
     free(fr->cb);
     free(fr->hs);
     free(fr->light_v);
@@ -520,6 +525,7 @@ void rs_worker_destroy(rs_worker *w)
         frame_free(w->frames[f]);
     free(w->lane_all);
     free(w->lane_value);
+    free(w->pixel_power);
     free(w->lane_at);
     free(w->cc_val);
     free(w->cc_stamp);
@@ -1834,7 +1840,8 @@ static int gather_room(frame *fr, size_t n)
             grow(&fr->gm_q, cap, sizeof *fr->gm_q) != 0 ||
             grow(&fr->gm_n, cap, sizeof *fr->gm_n) != 0 ||
             grow(&fr->gm_start, cap, sizeof *fr->gm_start) != 0 ||
-            grow(&fr->gm_lane, cap, sizeof *fr->gm_lane) != 0)
+            grow(&fr->gm_lane, cap, sizeof *fr->gm_lane) != 0 ||
+            grow(&fr->gm_power, cap, sizeof *fr->gm_power) != 0)
             return -1;
         fr->gm_cap = cap;
     }
@@ -1847,6 +1854,34 @@ static int gather_room(frame *fr, size_t n)
 static int lens_single(const frame *fr, const rs_object *ob, int n)
 {
     return fr->n_sub == n && n > 1 && !ob->u.lens.desc.uniaxial;
+}
+
+/* Whether the rays leaving a lens hit at frame f would only be added up
+ * as intensities: the camera ray's own hit (frame 0: its rays go into the
+ * pixel and nowhere else) in a scene where no rays interfere (pol_values
+ * adds their intensities, reading nothing else of them).  Its gathers
+ * then need not make the rays, only their power. */
+static int camera_power(const rs_integrator *it, int f)
+{
+    return f == 0 && !it->interferes;
+}
+
+/* The nr gathers of gather_all, at the camera ray's hit (camera_power):
+ * each one's power alone (lp_backward_gather_power_many: the Jones
+ * matrices of its way, no rays made), added to its lane of the pixel.  A
+ * gather that fails gives nothing, as there. */
+static void gather_power_all(rs_worker *w, frame *fr, size_t nr)
+{
+    if (lp_backward_gather_power_many(fr->gm_bw, fr->gm_q, fr->gm_b, fr->gm_n, nr, &fr->res,
+                                      fr->gm_power, NULL) != LP_OK) {
+        for (size_t k = 0; k < nr; k++) /* one by one, to drop the failing ones */
+            if (lp_backward_gather_power_many(fr->gm_bw + k, fr->gm_q + k, fr->gm_b + k,
+                                              fr->gm_n + k, 1, &fr->res, fr->gm_power + k,
+                                              NULL) != LP_OK)
+                fr->gm_power[k] = 0.0;
+    }
+    for (size_t k = 0; k < nr; k++)
+        w->pixel_power[fr->gm_lane[k]] += fr->gm_power[k];
 }
 
 /* The lens branch of trace_pol_hit where every sub-packet of the hit h
@@ -1889,9 +1924,13 @@ static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, doub
             nr++;
         }
     }
+    lp_result_clear(&fr->res);
+    if (camera_power(w->it, f)) {
+        gather_power_all(w, fr, nr);
+        return;
+    }
     /* a failed gather stops the call: its outputs are dropped, and the
      * gathers after it made by another (it is the last whose start is set) */
-    lp_result_clear(&fr->res);
     for (size_t from = 0; from < nr;) {
         for (size_t k = from; k < nr; k++)
             fr->gm_start[k] = SIZE_MAX;
@@ -2068,13 +2107,16 @@ static void pol_values(rs_worker *w, lp_vec3 o, lp_vec3 d, double *L)
     int nl = it->n_lanes;
     bundle_clear(&w->pixel);
     w->wavelets.n = 0;
+    for (int k = 0; k < nl; k++)
+        w->pixel_power[k] = 0.0;
     trace_pol(w, w->lane_all, nl, o, d, 1, 1.0, -1, 0, &w->pixel);
     const bundle *p = &w->pixel;
     if (!it->interferes) {
         /* every ray adds as an intensity: each lane's sum in its rays'
-         * order, as rs_coherent_power forms it */
+         * order, as rs_coherent_power forms it, after the power that came
+         * without rays */
         for (int k = 0; k < nl; k++)
-            L[k] = 0.0;
+            L[k] = w->pixel_power[k];
         for (size_t i = 0; i < p->n; i++) {
             int l = p->lane[i];
             if (l >= 0) {

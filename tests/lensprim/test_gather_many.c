@@ -1,5 +1,6 @@
 /* test_gather_many.c -- lp_backward_gather_many, the gathers of many
- * builders in one call.
+ * builders in one call, and lp_backward_gather_power_many, their power
+ * alone.
  *
  * identity   For placed and tilted lenses of every kind (dispersive
  *            catalog glasses with absorption, one in a dispersive medium,
@@ -19,6 +20,13 @@
  *            request's start, every outgoing ray (as bytes) and every sum
  *            must be identical; after a failure both go on from the next
  *            request.  The contract is exactness, so the tolerance is 0.
+ * power      lp_backward_gather_power_many of the same requests: the same
+ *            statuses and messages, no ray stored, each request's power
+ *            the sum of the intensities of the rays lp_backward_gather
+ *            gives it, and the sums, within rounding (power_from says
+ *            how much); among the failing rays some within a few 1e-12
+ *            of the light's direction, where the checks' verdicts must
+ *            agree.
  * errors     NULL arguments; count = 0.
  */
 #include <math.h>
@@ -52,11 +60,13 @@ static size_t req_q[MAX_REQ], req_n[MAX_REQ];
 static const lp_ray *req_b[MAX_REQ];
 static lp_ray rays[MAX_REQ][MAX_RAYS];
 
-static int n_cases, n_requests, n_rays, n_failed, n_out;
+static int n_cases, n_requests, n_rays, n_failed, n_out, n_power;
+static double worst_power;
 
 /* A bundle ray arriving back along the world direction qd (lambda_nm):
  * a random field direction, or one that fails (bad 1: an intensity that
- * is not a number, 2: a field along the light). */
+ * is not a number, 2: a field along the light) or may (3: a field within
+ * a few 1e-12 of the light's direction). */
 static lp_ray bundle_ray(lp_vec3 qd, double lambda_nm, int bad)
 {
     lp_ray r;
@@ -74,7 +84,91 @@ static lp_ray bundle_ray(lp_vec3 qd, double lambda_nm, int bad)
         r.intensity = NAN;
     else if (bad == 2)
         r.vp = qd;
+    else if (bad == 3) { /* near the check's limit: a part across the light of
+                          * 0.3e-12 .. 3e-12 of the field (it fails below 1e-12) */
+        lp_vec3 a = fabs(qd.x) < 0.9 ? vec(1, 0, 0) : vec(0, 1, 0);
+        lp_vec3 c = vec(qd.y * a.z - qd.z * a.y, qd.z * a.x - qd.x * a.z, qd.x * a.y - qd.y * a.x);
+        double e = 1e-12 * (0.3 + 2.7 * uniform());
+        r.vp = vec(qd.x + e * c.x, qd.y + e * c.y, qd.z + e * c.z);
+    }
     return r;
+}
+
+/* lp_backward_gather_power_many of the requests of [from, count), whose
+ * gathers one by one fail at `failed` (count: none) with sa and message
+ * want: the same status and message, no ray stored, each request's power
+ * the sum of the intensities of the rays its gather appends (the failing
+ * one's before its failing ray), and the sums of those gathers (made
+ * again here into a result of their own).
+ *
+ * The tolerance: every factor of a way (Fresnel's power-normalized
+ * amplitudes, the axes' cosines, the segments' attenuations) is at most
+ * 1 in size, so each rounding of a ray's amplitude is at most eps
+ * (2^-53) of the ray's own amplitude; a way of k <= 16 nodes takes about
+ * 10 of them a node in either computation (3-vectors projected and
+ * rebuilt, or 2 x 2 products), and a request adds up at most 20 rays: at
+ * most 2 (10 x 16 + 20) eps = 4.0e-14 of the bundle's intensity apart
+ * (of the call's intensity for the sums).  A field direction v given to
+ * rounding (eps |v|) has its part across the light known to eps |v| too,
+ * so a ray whose v is within a fraction f of the light's direction (the
+ * rays near the check's limit, f ~ 1e-12) has its direction across the
+ * light, and its power, known to about 2 eps / f: both computations may
+ * differ by twice that, 4 eps / f of its intensity. */
+/* The part of v across the unit d, over |v| (0 for a zero v). */
+static double across(lp_vec3 v, lp_vec3 d)
+{
+    lp_vec3 c = vec(v.y * d.z - v.z * d.y, v.z * d.x - v.x * d.z, v.x * d.y - v.y * d.x);
+    double l = sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+    return l > 0.0 ? sqrt(c.x * c.x + c.y * c.y + c.z * c.z) / l : 0.0;
+}
+
+static void power_from(const char *name, size_t from, size_t count, size_t failed, lp_status sa,
+                       const char *want)
+{
+    static lp_result c, d;
+    static double power[MAX_REQ];
+    const double tol = 2.0 * (10.0 * 16.0 + 20.0) * 0x1p-53;
+    lp_error ec;
+    lp_result_clear(&c);
+    lp_result_clear(&d);
+    lp_status sc = lp_backward_gather_power_many(req_bw + from, req_q + from, req_b + from,
+                                                 req_n + from, count - from, &c, power, &ec);
+    CHECK(sc == sa, "%s: power: status %d / %d (%s)", name, (int)sa, (int)sc, ec.message);
+    if (sa != LP_OK)
+        CHECK(strcmp(ec.message, want) == 0, "%s: power: '%s', want '%s'", name, ec.message,
+              want);
+    CHECK(c.count == 0, "%s: power: %zu rays stored", name, c.count);
+    double sum_allow = 0.0;
+    for (size_t k = from; k < failed && k < count; k++) {
+        size_t start = d.count;
+        lp_backward_gather(req_bw[k], req_q[k], req_b[k], req_n[k], &d, NULL);
+        double want_p = 0.0, in_k = 0.0, allow = 0.0;
+        for (size_t t = start; t < d.count; t++)
+            want_p += d.rays[t].ray.intensity;
+        int has_q = req_bw[k] && req_q[k] < lp_backward_query_count(req_bw[k]);
+        lp_vec3 qd = has_q ? lp_backward_queries(req_bw[k])[req_q[k]].dir : vec(0, 0, 1);
+        for (size_t i = 0; i < req_n[k] && req_b[k]; i++) {
+            const lp_ray *r = &req_b[k][i];
+            double I = isfinite(r->intensity) ? r->intensity : 0.0;
+            in_k += I;
+            if (I > 0.0)
+                allow += I * (tol + 4.0 * 0x1p-53 / across(r->vp, qd));
+        }
+        double e = allow > 0.0 ? fabs(power[k - from] - want_p) / allow : 0.0;
+        CHECK(fabs(power[k - from] - want_p) <= allow, "%s: request %zu: power %.17g, its rays %.17g (in %g)", name, k,
+              power[k - from], want_p, in_k);
+        worst_power = e > worst_power ? e : worst_power;
+        sum_allow += allow;
+        n_power++;
+    }
+    CHECK(failed < count || (c.nodes == d.nodes && c.warnings == d.warnings), "%s: power: nodes %zu / %zu, warnings %u / %u",
+          name, c.nodes, d.nodes, c.warnings, d.warnings);
+    CHECK(failed < count || (c.in == d.in && fabs(c.out - d.out) <= sum_allow &&
+              fabs(c.absorbed_glass - d.absorbed_glass) <= sum_allow &&
+              fabs(c.truncated - d.truncated) <= sum_allow),
+          "%s: power: sums in %.17g / %.17g, out %.17g / %.17g, absorbed %.17g / %.17g, "
+          "truncated %.17g / %.17g", name, c.in, d.in, c.out, d.out, c.absorbed_glass,
+          d.absorbed_glass, c.truncated, d.truncated);
 }
 
 /* The requests k of [from, count) one by one into a, the many call into
@@ -114,6 +208,7 @@ static size_t compare_from(const char *name, size_t from, size_t count, lp_resul
         CHECK(start_b[i] == SIZE_MAX, "%s: request %zu after the failure is set", name, i);
     CHECK(same_books(a, b), "%s: the sums or counts differ (%zu / %zu rays)", name, a->count,
           b->count);
+    power_from(name, from, count, k, sa, want);
     size_t differ = 0;
     for (size_t t = 0; t < a->count && t < b->count; t++)
         differ += !same_out_ray(&a->rays[t], &b->rays[t]);
@@ -143,7 +238,7 @@ static void gather_case(const char *name, size_t nb, const double *lambda, int i
         double u = uniform();
         size_t n = u < 0.05 ? 0 : u < 0.6 ? 2 : u < 0.8 ? 1 : (size_t)(MAX_RAYS * uniform());
         for (size_t i = 0; i < n; i++)
-            rays[count][i] = bundle_ray(qd, lambda[s], bad && uniform() < 0.02 ? 1 + (int)(2.0 * uniform()) : 0);
+            rays[count][i] = bundle_ray(qd, lambda[s], bad && uniform() < 0.02 ? 1 + (int)(3.0 * uniform()) : 0);
         req_bw[count] = bws[s];
         req_q[count] = j;
         req_n[count] = n;
@@ -232,6 +327,8 @@ static void test_identity(void)
            "every status, message, start, ray and sum identical to lp_backward_gather's\n",
            n_cases, n_requests, n_rays, n_out, n_failed);
     CHECK(n_failed > 0 && n_out > 0, "failures and outgoing rays were exercised");
+    printf("power: %d requests, worst |power - sum of rays| %.3g of the tolerance\n", n_power,
+           worst_power);
 }
 
 static void test_errors(void)
@@ -261,6 +358,19 @@ static void test_errors(void)
     CHECK(lp_backward_gather_many(NULL, NULL, NULL, NULL, 0, &r, NULL, &err) == LP_OK,
           "count = 0: nothing to do");
     CHECK(r.count == 0 && r.in == 0.0, "count = 0 leaves out as it is");
+    double power = 7.0;
+    CHECK(lp_backward_gather_power_many(&b, &q, &bundle, &n, 1, NULL, &power, &err) ==
+              LP_ERROR_INVALID_ARGUMENT,
+          "power: NULL out");
+    CHECK(lp_backward_gather_power_many(&b, &q, &bundle, &n, 1, &r, NULL, &err) ==
+              LP_ERROR_INVALID_ARGUMENT,
+          "power: NULL power");
+    CHECK(lp_backward_gather_power_many(NULL, &q, &bundle, &n, 1, &r, &power, &err) ==
+              LP_ERROR_INVALID_ARGUMENT,
+          "power: NULL builders");
+    CHECK(power == 7.0 && r.count == 0, "power: nothing done before the arguments check out");
+    CHECK(lp_backward_gather_power_many(NULL, NULL, NULL, NULL, 0, &r, NULL, &err) == LP_OK,
+          "power: count = 0: nothing to do");
     lp_result_release(&r);
 }
 

@@ -18,6 +18,9 @@
  * propagation phase and Beer-Lambert absorption of a hand-made glass
  * (tau flat in lambda).  fresnel and schlick modes compare intensities,
  * also with the node product of (Rs+Rp)/2 or Schlick's law written here.
+ * The power of each gather alone (lp_backward_gather_power_many: the
+ * Jones matrices of its way) is compared with the exact chain's too
+ * (1e-10), TIR paths among them.
  *
  * Paths that are ill-conditioned in double precision are not compared
  * (and counted): a node within 1e-6 x size of a cap's edge circle, an
@@ -249,6 +252,7 @@ static char ctx[256];
 
 typedef struct {
     long compared, skipped_cond, skipped_sens, queries, view_rays, tir_paths;
+    long power_compared, power_tir; /* lp_backward_gather_power_many's requests */
     double worst_field_fb, worst_field_ref, worst_int_fb, worst_op;
 } stats;
 static stats st_pol, st_unp;
@@ -319,9 +323,10 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
     lp_trace_args_init(&args);
     args.mode = mode;
     args.max_depth = 2 + (int)(sm64() % 5);
-    lp_result g, fw;
+    lp_result g, fw, pw;
     lp_result_init(&g);
     lp_result_init(&fw);
+    lp_result_init(&pw);
     for (int vi = 0; vi < 3; vi++) {
         /* a view ray entering a random cap point from outside */
         int back = (int)(sm64() & 1);
@@ -460,6 +465,19 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
             CHECK_REL(gsum, g.out, 1e-12, "%s: gather out = sum of its rays", ctx);
             CHECK(g.count >= 2 && g.count <= 4, "%s: gather returned %zu rays for 2 bundle rays", ctx,
                   g.count);
+            /* the same request's power alone (lp_backward_gather_power_many) */
+            const lp_backward *pb = bw;
+            const lp_ray *pbundle = bundle;
+            size_t pq = qi, pn = 2;
+            double power = -1.0;
+            lp_result_clear(&pw);
+            stt = lp_backward_gather_power_many(&pb, &pq, &pbundle, &pn, 1, &pw, &power, &err);
+            CHECK(stt == LP_OK, "%s: gather_power: %s", ctx, err.message);
+            CHECK(pw.count == 0 && pw.in == g.in && pw.nodes == g.nodes,
+                  "%s: gather_power: %zu rays, in %.17g / %.17g", ctx, pw.count, pw.in, g.in);
+            CHECK_REL(pw.out, g.out, 1e-12, "%s: gather_power: out", ctx);
+            ref_real exact_sum = 0;
+            int n_exact = 0, tir_here = 0;
             for (size_t i = 0; i < g.count; i++) {
                 const lp_out_ray *o = &g.rays[i];
                 CHECK(o->depth == k && o->kind == q->kind && o->path == q->path,
@@ -537,6 +555,9 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
                     CHECK_REL((double)Ig, (double)If, 1e-10, "%s: bundle %d: intensity gathered vs forward",
                               ctx, b);
                     CHECK_REL((double)Ig, (double)Ir, 1e-10, "%s: bundle %d: intensity vs exact", ctx, b);
+                    exact_sum += Ir;
+                    n_exact++;
+                    tir_here |= nf == 2 || ng_ == 2;
                     CHECK(Ig <= P_bound * Ib * (1 + REF(1e-10)), "%s: gathered intensity above the bound",
                           ctx);
                     CHECK_ABS((double)opg, (double)opf, tol_op, "%s: bundle %d: gathered op = forward op",
@@ -564,12 +585,20 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
                     CHECK_REL(Ig, q->bound * Ib, 1e-10, "%s: bundle %d: gathered = bound x I (exact "
                               "transmittance in this mode)", ctx, b);
                     S->worst_int_fb = fmax(S->worst_int_fb, fabs(Ig - If) / fmax(If, 1e-300));
+                    exact_sum += want;
+                    n_exact++;
                 }
+            }
+            if (n_exact == 2) { /* the power against the exact Jones (or Fresnel) chain's */
+                CHECK_REL(power, (double)exact_sum, 1e-10, "%s: gather_power vs exact", ctx);
+                S->power_compared++;
+                S->power_tir += tir_here;
             }
         }
     }
     lp_result_release(&g);
     lp_result_release(&fw);
+    lp_result_release(&pw);
     lp_lens_destroy(lens);
 }
 
@@ -597,7 +626,11 @@ int main(void)
            "worst intensity f/g %.3g\n",
            st_unp.view_rays, st_unp.queries, st_unp.compared, st_unp.skipped_cond, st_unp.skipped_sens,
            st_unp.worst_int_fb);
+    printf("test_reciprocity: gather_power against the exact chain: polarized %ld requests (%ld "
+           "with TIR parts), fresnel+schlick %ld\n",
+           st_pol.power_compared, st_pol.power_tir, st_unp.power_compared);
     CHECK(st_pol.compared >= 1000, "enough polarized comparisons (%ld)", st_pol.compared);
+    CHECK(st_pol.power_tir >= 10, "TIR paths among gather_power's (%ld)", st_pol.power_tir);
     CHECK(st_pol.tir_paths >= 10, "TIR paths among the comparisons (%ld)", st_pol.tir_paths);
     CHECK(st_unp.compared >= 500, "enough unpolarized comparisons (%ld)", st_unp.compared);
     lp_backward_destroy(bw);
