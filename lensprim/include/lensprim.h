@@ -454,8 +454,16 @@ typedef int (*lp_filter_fn)(const lp_branch_info *info, void *user);
 
 enum {
     LP_SKIP_EXTERNAL_REFLECTION = 1u << 0, /* drop the depth-1 reflection */
-    LP_SKIP_REFLECTED = 1u << 1            /* drop every ray leaving on the
+    LP_SKIP_REFLECTED = 1u << 1,           /* drop every ray leaving on the
                                               incoming side */
+    /* (Revision 2) A polarized backward build whose queries' light will be
+     * added up for its power only (lp_backward_gather_power_many): the
+     * build makes each query's power form -- its way's Jones matrix,
+     * grown node by node as the view ray's chain is walked -- instead of
+     * setting up the ways that lp_backward_gather carries rays along
+     * (that call still gives the same rays, setting its way up itself).
+     * Ignored by forward traces and the unpolarized modes. */
+    LP_BACKWARD_POWER = 1u << 2
 };
 
 #define LP_MAX_DEPTH 64
@@ -466,7 +474,7 @@ typedef struct lp_trace_args {
     double min_weight;    /* cut an internal branch when its power relative
                              to the input (forward) or its bound (backward)
                              falls below this; default 0 = never */
-    unsigned flags;       /* LP_SKIP_* */
+    unsigned flags;       /* LP_SKIP_*, LP_BACKWARD_POWER */
     lp_filter_fn filter;  /* optional */
     void *user;           /* passed to filter */
 } lp_trace_args;
@@ -655,25 +663,23 @@ LP_API lp_status lp_backward_gather_many(const lp_backward *const *bw, const siz
  * n[k], ...) appends, to rounding (about 1e-15 of the bundle's
  * intensity; more for a field direction within 1e-10 of the light's,
  * whose part across the light is itself known only to rounding).  For an
- * application that only adds up the light that
- * leaves -- an image of intensities, where nothing after the lens sees
- * polarization and no rays interfere -- at a fraction of the cost: in
- * the polarized mode each ray is carried through the 2 x 2 Jones matrices
- * of its way (the power leaving is |J E|^2; no phase jump, ellipse or
- * stored ray is needed), and any other request (an unpolarized build, a
- * crystal, a way with a node at normal incidence) is gathered by
- * lp_backward_gather and its rays' intensities added up.  out gains the
- * sums those gathers would add to it (in, out, absorbed_glass,
- * truncated, nodes, warnings) but no rays: out->count is left as it was.
- * Errors as lp_backward_gather_many's: the first request that fails
- * stops the call with its message prefixed by "request k: ", power[0 ..
- * k) set and power[k] the power of its rays before the failing one; out
- * then holds the sums of those.  A NULL out, or a NULL bw, q, bundle, n
- * or power when count > 0, gives LP_ERROR_INVALID_ARGUMENT. */
+ * application that only adds up the light that leaves -- an image of
+ * intensities, where nothing after the lens sees polarization and no
+ * rays interfere.  Of a build made with LP_BACKWARD_POWER (polarized, not
+ * a crystal) each query has its power form P, the 2 x 2 matrix with
+ * |T x|^2 = x' P x for T its way's Jones matrix: a ray of intensity I and
+ * field direction v, x = sqrt(I) (v.s, v.p) / |(v.s, v.p)| on the axes
+ * of the light entering, leaves with power x' P x -- no phase jump,
+ * ellipse or stored ray.  Any other request (another build, a way with a
+ * node at normal incidence) is gathered by lp_backward_gather and its
+ * rays' intensities added up.  Errors as lp_backward_gather_many's: the
+ * first request that fails stops the call with lp_backward_gather's
+ * message prefixed by "request k: ", power[0 .. k) set.  A NULL bw, q,
+ * bundle, n or power when count > 0 gives LP_ERROR_INVALID_ARGUMENT;
+ * count 0 does nothing. */
 LP_API lp_status lp_backward_gather_power_many(const lp_backward *const *bw, const size_t *q,
                                                const lp_ray *const *bundle, const size_t *n,
-                                               size_t count, lp_result *out, double *power,
-                                               lp_error *err);
+                                               size_t count, double *power, lp_error *err);
 
 /* ------------------------------------------------------------------ */
 /* The cone K of rim-free directions (the paper's section 5)           */

@@ -56,6 +56,13 @@ struct lp_backward {
      * incidence nor a total internal reflection where the light
      * refracts; -1 otherwise (one ray at a time) */
     signed char complex_at[LP_MAX_DEPTH];
+    /* per query, its power form (a build with LP_BACKWARD_POWER: jones.h):
+     * P (entries 00, 01, 11) and the axes s, p (world) of the light
+     * entering; pform_ok 0: none (another build, or a node at normal
+     * incidence on its way) */
+    double pform[LP_MAX_DEPTH][3];
+    lp_vec3 pform_s[LP_MAX_DEPTH], pform_p[LP_MAX_DEPTH];
+    signed char pform_ok[LP_MAX_DEPTH];
     /* lp_backward_build_many's mark: whether this builder was met
      * already in its list (found in two passes, not by comparing pairs) */
     unsigned char listed;
@@ -75,6 +82,19 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
                                lp_vec3 dir, lp_vec3 world_origin, lp_vec3 world_dir,
                                uint64_t path, double op, double bound, double weight,
                                int leaves);
+
+/* Whether a build with args makes its queries' power forms: polarized,
+ * with LP_BACKWARD_POWER (a crystal's build makes none). */
+static inline int lp__backward_power(const lp_trace_args *args)
+{
+    return args->mode == LP_MODE_POLARIZED && (args->flags & LP_BACKWARD_POWER) != 0;
+}
+
+/* Keep the power form (P, the entry's world axes s, p, ok) for the query
+ * just added to bw if lp__backward_add_query(_at) added one (n_queries
+ * was `before`). */
+void lp__backward_keep_form(lp_backward *bw, size_t before, const double P[3], lp_vec3 s,
+                            lp_vec3 p, double ok);
 
 /* Once a build of bw is done: in the polarized mode, whose light comes
  * only by gathering, set up the ways of every gather of its queries

@@ -22,6 +22,7 @@
 
 #include "backward.h"
 #include "error.h"
+#include "jones.h"
 #include "lanes.h"
 
 /* Wavelengths per group (16 is what a spectral renderer traces). */
@@ -45,7 +46,41 @@ typedef struct wl_lanes {
     /* the query in the world: its origin (the node) and direction */
     double wox[NW], woy[NW], woz[NW], wdx[NW], wdy[NW], wdz[NW];
     double lv[NW]; /* whether the query leaves the lens (leaves_step) */
+    /* a power build's (jones.h): the light's way to the exit so far (R,
+     * its axes at the node before, whether defined), and the query's
+     * form, entry axes (world) and whether defined */
+    double Rr00[NW], Rr01[NW], Rr10[NW], Rr11[NW], Ri00[NW], Ri01[NW], Ri10[NW], Ri11[NW];
+    double sx[NW], sy[NW], sz[NW], tx[NW], ty[NW], tz[NW], jok[NW];
+    double P0[NW], P1[NW], P2[NW], esx[NW], esy[NW], esz[NW], epx[NW], epy[NW], epz[NW];
+    double qok[NW];
 } wl_lanes;
+
+/* Lane k's Jones state (R, the axes before: s in s*, p in t*, ok) in and
+ * out of its arrays, and its query's form out. */
+LP__INLINE void jones_load(const wl_lanes *restrict W, size_t k, lp__cm2 *R, lp_vec3 *s,
+                           lp_vec3 *p, double *ok)
+{
+    *R = (lp__cm2){W->Rr00[k], W->Rr01[k], W->Rr10[k], W->Rr11[k],
+                   W->Ri00[k], W->Ri01[k], W->Ri10[k], W->Ri11[k]};
+    *s = v3(W->sx[k], W->sy[k], W->sz[k]);
+    *p = v3(W->tx[k], W->ty[k], W->tz[k]);
+    *ok = W->jok[k];
+}
+
+LP__INLINE void jones_store(wl_lanes *restrict W, size_t k, const lp__cm2 *R, lp_vec3 s,
+                            lp_vec3 p, double ok, const double P[3], lp_vec3 es, lp_vec3 ep,
+                            double qok)
+{
+    W->Rr00[k] = R->r00, W->Rr01[k] = R->r01, W->Rr10[k] = R->r10, W->Rr11[k] = R->r11;
+    W->Ri00[k] = R->i00, W->Ri01[k] = R->i01, W->Ri10[k] = R->i10, W->Ri11[k] = R->i11;
+    W->sx[k] = s.x, W->sy[k] = s.y, W->sz[k] = s.z;
+    W->tx[k] = p.x, W->ty[k] = p.y, W->tz[k] = p.z;
+    W->jok[k] = ok;
+    W->P0[k] = P[0], W->P1[k] = P[1], W->P2[k] = P[2];
+    W->esx[k] = es.x, W->esy[k] = es.y, W->esz[k] = es.z;
+    W->epx[k] = ep.x, W->epy[k] = ep.y, W->epz[k] = ep.z;
+    W->qok[k] = qok;
+}
 
 /* The bound and weight factors of a node (trace_backward.c's node_bound
  * and node_weight) for the reflected and the transmitted branch. */
@@ -71,7 +106,7 @@ LP__INLINE void factors(lp_mode mode, double r0, double n1, double n2, const lp_
 /* Node 1 of every lane: the view ray enters at the point of the unit
  * normal hn, along d; the reflected query and the refracted chain. */
 LP__INLINE void entry_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp, lp_mode mode,
-                           lp_vec3 d, lp_vec3 hn)
+                           int power, lp_vec3 d, lp_vec3 hn)
 {
     const lp__lane_lens K = *Kp; /* local: the loads are safe to select */
     for (size_t k = 0; k < n; k++) {
@@ -96,6 +131,16 @@ LP__INLINE void entry_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *
         W->weight[k] = wT;
         W->op[k] = 0.0;
         W->live[k] = g.tir ? 0.0 : 1.0;
+        if (power) { /* jones.h, with trace_backward.c's numbers */
+            lp__cm2 R;
+            lp_vec3 s, p, es, ep;
+            double ok, qok, P[3];
+            double gg = 2.0 * sqrt(g.a * g.b);
+            lp__jones_first(d, hn, g.r, g.t, g.rs, g.rp, gg * g.is, gg * g.ip, &R, &s, &p, &ok, P,
+                            &es, &ep, &qok);
+            jones_store(W, k, &R, s, p, ok, P, lp__lane_world_dir(&K, es),
+                        lp__lane_world_dir(&K, ep), qok);
+        }
     }
 }
 
@@ -126,7 +171,8 @@ LP__INLINE void hit_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp
 
 /* The segment to the hit and the node there, for every lane that met a
  * cap: the query's direction, bound and weight, the reflected chain. */
-LP__INLINE void node_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp, lp_mode mode)
+LP__INLINE void node_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *Kp, lp_mode mode,
+                          int power)
 {
     const lp__lane_lens K = *Kp;
     for (size_t k = 0; k < n; k++) {
@@ -166,6 +212,18 @@ LP__INLINE void node_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *K
         W->dy[k] = g.r.y;
         W->dz[k] = g.r.z;
         W->surf[k] = hs;
+        if (power) { /* jones.h, with trace_backward.c's numbers */
+            lp__cm2 R;
+            lp_vec3 s, p, es, ep;
+            double ok, qok, P[3], ar, ai, br, bi;
+            double gg = 2.0 * sqrt(g.a * g.b);
+            jones_load(W, k, &R, &s, &p, &ok);
+            lp__jones_reflection(g.rs, g.rp, g.tir, g.ci, W->ng[k], W->nm[k], &ar, &ai, &br, &bi);
+            lp__jones_node(d, nrm, g.r, g.t, 1.0 + m, gg * g.is, gg * g.ip, ar, ai, br, bi, &R, &s,
+                           &p, &ok, P, &es, &ep, &qok);
+            jones_store(W, k, &R, s, p, ok, P, lp__lane_world_dir(&K, es),
+                        lp__lane_world_dir(&K, ep), qok);
+        }
     }
 }
 
@@ -216,12 +274,17 @@ LP__INLINE void leaves_step(wl_lanes *restrict W, size_t n, const lp__lane_lens 
 
 /* The vector loops, each in one copy per mode and vector width. */
 LP__WIDE static void entry_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K,
-                                  lp_mode mode, lp_vec3 d, lp_vec3 hn)
+                                  lp_mode mode, int power, lp_vec3 d, lp_vec3 hn)
 {
     switch (mode) {
-    case LP_MODE_POLARIZED: entry_step(W, n, K, LP_MODE_POLARIZED, d, hn); break;
-    case LP_MODE_FRESNEL: entry_step(W, n, K, LP_MODE_FRESNEL, d, hn); break;
-    default: entry_step(W, n, K, LP_MODE_SCHLICK, d, hn); break;
+    case LP_MODE_POLARIZED:
+        if (power)
+            entry_step(W, n, K, LP_MODE_POLARIZED, 1, d, hn);
+        else
+            entry_step(W, n, K, LP_MODE_POLARIZED, 0, d, hn);
+        break;
+    case LP_MODE_FRESNEL: entry_step(W, n, K, LP_MODE_FRESNEL, 0, d, hn); break;
+    default: entry_step(W, n, K, LP_MODE_SCHLICK, 0, d, hn); break;
     }
 }
 
@@ -237,12 +300,17 @@ LP__WIDE static void leaves_kernel(wl_lanes *restrict W, size_t n, const lp__lan
 }
 
 LP__WIDE static void node_kernel(wl_lanes *restrict W, size_t n, const lp__lane_lens *K,
-                                 lp_mode mode)
+                                 lp_mode mode, int power)
 {
     switch (mode) {
-    case LP_MODE_POLARIZED: node_step(W, n, K, LP_MODE_POLARIZED); break;
-    case LP_MODE_FRESNEL: node_step(W, n, K, LP_MODE_FRESNEL); break;
-    default: node_step(W, n, K, LP_MODE_SCHLICK); break;
+    case LP_MODE_POLARIZED:
+        if (power)
+            node_step(W, n, K, LP_MODE_POLARIZED, 1);
+        else
+            node_step(W, n, K, LP_MODE_POLARIZED, 0);
+        break;
+    case LP_MODE_FRESNEL: node_step(W, n, K, LP_MODE_FRESNEL, 0); break;
+    default: node_step(W, n, K, LP_MODE_SCHLICK, 0); break;
     }
 }
 
@@ -250,9 +318,17 @@ LP__WIDE static void node_kernel(wl_lanes *restrict W, size_t n, const lp__lane_
  * reflected one) of lane k, kept in the builder's own query slot
  * depth - 1 until lp__backward_add_query_at makes the queries: so no
  * scratch is needed. */
-static void keep_candidate(lp_backward *bw, int depth, const wl_lanes *W, size_t k, lp_vec3 wo)
+static void keep_candidate(lp_backward *bw, int depth, const wl_lanes *W, size_t k, lp_vec3 wo,
+                           int power)
 {
     lp_query *q = &bw->query[depth - 1];
+    if (power) { /* its form and world entry axes, in the slot's too */
+        double *P = bw->pform[depth - 1];
+        P[0] = W->P0[k], P[1] = W->P1[k], P[2] = W->P2[k];
+        bw->pform_s[depth - 1] = v3(W->esx[k], W->esy[k], W->esz[k]);
+        bw->pform_p[depth - 1] = v3(W->epx[k], W->epy[k], W->epz[k]);
+        bw->pform_ok[depth - 1] = W->qok[k] != 0.0;
+    }
     bw->query_dir[depth - 1] = v3(W->qx[k], W->qy[k], W->qz[k]);
     q->origin = wo;
     q->dir = v3(W->wdx[k], W->wdy[k], W->wdz[k]);
@@ -270,7 +346,7 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
     wl_lanes W;
     const lp_trace_args *a = &bw[0]->args;
     lp_mode mode = a->mode;
-    int entry = h->surface, max_depth = a->max_depth;
+    int entry = h->surface, max_depth = a->max_depth, power = lp__backward_power(a);
     int cand[NW][LP_MAX_DEPTH + 1]; /* 1: node j of lane k has a candidate */
 
     for (size_t k = 0; k < n; k++) {
@@ -285,7 +361,7 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         W.px[k] = h->p.x, W.py[k] = h->p.y, W.pz[k] = h->p.z;
         W.surf[k] = h->surface;
     }
-    entry_kernel(&W, n, K, mode, d, h->n);
+    entry_kernel(&W, n, K, mode, power, d, h->n);
     lp__exit exit = lp__exit_at(lens, h->p, v3_neg(d));
     lp_vec3 wo1 = lp__to_world_point(lens, h->p);
     for (size_t k = 0; k < n; k++)
@@ -299,7 +375,7 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         b->node[1].n = h->n;
         b->node[1].surface = h->surface;
         b->node[1].e_out = v3(W.dx[k], W.dy[k], W.dz[k]);
-        keep_candidate(b, 1, &W, k, wo1);
+        keep_candidate(b, 1, &W, k, wo1, power);
         cand[k][1] = 1;
     }
     /* the chains, a node per step */
@@ -324,7 +400,7 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
         }
         if (live == 0)
             break;
-        node_kernel(&W, n, K, mode);
+        node_kernel(&W, n, K, mode, power);
         leaves_kernel(&W, n, K);
         for (size_t k = 0; k < n; k++) {
             if (W.live[k] == 0.0)
@@ -352,7 +428,7 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
             b->n_nodes = depth + 1;
             cand[k][depth + 1] = W.tir[k] == 0.0;
             if (cand[k][depth + 1])
-                keep_candidate(b, depth + 1, &W, k, v3(W.wox[k], W.woy[k], W.woz[k]));
+                keep_candidate(b, depth + 1, &W, k, v3(W.wox[k], W.woy[k], W.woz[k]), power);
         }
     }
     /* the queries, wavelength by wavelength, in depth order */
@@ -366,9 +442,15 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
                 const lp_query *q = &b->query[j - 1];
                 int surface = b->node[j].surface;
                 lp_kind kind = j == 1 || surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
+                size_t before = b->n_queries;
+                double P[3] = {b->pform[j - 1][0], b->pform[j - 1][1], b->pform[j - 1][2]};
+                lp_vec3 es = b->pform_s[j - 1], ep = b->pform_p[j - 1];
+                double ok = b->pform_ok[j - 1];
                 lp__backward_add_query_at(b, j, kind, surface, b->query_dir[j - 1], q->origin,
                                           q->dir, j == 1 ? 1u : path, q->op, q->bound,
                                           q->weight, b->leaves[j - 1]);
+                if (power)
+                    lp__backward_keep_form(b, before, P, es, ep, ok);
             }
             if (j > 1)
                 path |= (uint64_t)1 << (j - 1);

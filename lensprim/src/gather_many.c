@@ -27,9 +27,10 @@
  * code's bit for bit, and the outgoing rays are stored request by
  * request, ray by ray, as the gathers one by one store them.  A request
  * the lanes do not take -- a crystal lens, a way of normal incidence, a
- * bundle too long, a ray that fails its checks, a complex field that
- * turns real again -- is gathered by lp_backward_gather itself in its
- * turn, so its results (and its error) are that call's. */
+ * build for power alone (LP_BACKWARD_POWER: no ways), a bundle too long,
+ * a ray that fails its checks, a complex field that turns real again --
+ * is gathered by lp_backward_gather itself in its turn, so its results
+ * (and its error) are that call's. */
 #include <math.h>
 
 #include "backward.h"

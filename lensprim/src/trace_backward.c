@@ -20,6 +20,7 @@
 #include <stdlib.h>
 
 #include "backward.h"
+#include "jones.h"
 #include "error.h"
 #include "interface.h"
 
@@ -153,7 +154,20 @@ static void mark_ways(lp_backward *bw, int deepest)
 
 int lp__backward_sets_ways(const lp_backward *bw)
 {
-    return bw->args.mode == LP_MODE_POLARIZED && !lp__xback_active(bw->xb);
+    return bw->args.mode == LP_MODE_POLARIZED && !lp__backward_power(&bw->args) &&
+           !lp__xback_active(bw->xb);
+}
+
+void lp__backward_keep_form(lp_backward *bw, size_t before, const double P[3], lp_vec3 s,
+                            lp_vec3 p, double ok)
+{
+    if (bw->n_queries == before)
+        return;
+    size_t k = bw->n_queries - 1;
+    bw->pform[k][0] = P[0], bw->pform[k][1] = P[1], bw->pform[k][2] = P[2];
+    bw->pform_s[k] = s;
+    bw->pform_p[k] = p;
+    bw->pform_ok[k] = ok != 0.0;
 }
 
 /* The ways of every query of a polarized build (backward.h). */
@@ -208,7 +222,8 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
 
     if (bound < bw->args.min_weight)
         return;
-    if (bw->args.flags != 0 || bw->args.filter) { /* else lp__args_keep keeps it */
+    if ((bw->args.flags & ~(unsigned)LP_BACKWARD_POWER) != 0 ||
+        bw->args.filter) { /* else lp__args_keep keeps it */
         lp_branch_info info = {depth, kind, surface, world_origin, world_dir, bound};
         if (!lp__args_keep(&bw->args, &info))
             return;
@@ -223,6 +238,7 @@ void lp__backward_add_query_at(lp_backward *bw, int depth, lp_kind kind, int sur
     q->bound = bound;
     q->weight = weight;
     q->waves = 0;
+    bw->pform_ok[bw->n_queries] = 0;
     bw->query_dir[bw->n_queries] = dir;
     bw->leaves[bw->n_queries] = (signed char)leaves;
     bw->n_queries++;
@@ -278,8 +294,21 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
     bw->node[1].surface = h.surface;
     /* the branches' directions and powers (no fields) */
     int tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_medium, o->n_glass);
+    /* the light's way as a Jones matrix (jones.h), in a power build */
+    const int power = lp__backward_power(&bw->args);
+    lp__cm2 R = lp__jones_diag(0.0, 0.0, 0.0, 0.0);
+    lp_vec3 s_prev = v3(0, 0, 0), p_prev = s_prev, es = s_prev, ep = s_prev;
+    double jok = 0.0, qok = 0.0, P[3] = {0.0, 0.0, 0.0};
+    if (power)
+        lp__jones_first(d, h.n, lp__node_reflect_dir(&nd), lp__node_transmit_dir(&nd),
+                        creal(nd.f.rs), creal(nd.f.rp), nd.f.ts, nd.f.tp, &R, &s_prev, &p_prev,
+                        &jok, P, &es, &ep, &qok);
+    size_t before = bw->n_queries;
     lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, lp__node_reflect_dir(&nd), 1u, 0.0,
                            node_bound(&nd, mode, 1), node_weight(&nd, mode, 1));
+    if (power && bw->n_queries > before)
+        lp__backward_keep_form(bw, before, P, lp__to_world_dir(lens, es),
+                               lp__to_world_dir(lens, ep), qok);
     if (tir) {
         lp__ok(err);
         return LP_OK;
@@ -316,12 +345,24 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
         bw->node[depth].n = h.n;
         bw->node[depth].surface = h.surface;
         tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_glass, o->n_medium);
+        if (power) {
+            double ar, ai, br, bi;
+            lp__jones_reflection(creal(nd.f.rs), creal(nd.f.rp), nd.f.tir, nd.cos_i, o->n_glass,
+                                 o->n_medium, &ar, &ai, &br, &bi);
+            lp__jones_node(d, h.n, lp__node_reflect_dir(&nd), lp__node_transmit_dir(&nd), 1.0 + m,
+                           nd.f.ts, nd.f.tp, ar, ai, br, bi, &R, &s_prev, &p_prev, &jok, P, &es,
+                           &ep, &qok);
+        }
+        before = bw->n_queries;
         if (!tir)
             lp__backward_add_query(bw, depth,
                                    h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
                                    h.surface, lp__node_transmit_dir(&nd), path, op,
                                    bound * node_bound(&nd, mode, 0),
                                    weight * node_weight(&nd, mode, 0));
+        if (power && bw->n_queries > before)
+            lp__backward_keep_form(bw, before, P, lp__to_world_dir(lens, es),
+                                   lp__to_world_dir(lens, ep), qok);
         bound *= node_bound(&nd, mode, 1);
         weight *= node_weight(&nd, mode, 1);
         path |= (uint64_t)1 << (depth - 1);

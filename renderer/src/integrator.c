@@ -1205,17 +1205,35 @@ static int lens_args(const rs_integrator *it, int level, double weight, lp_trace
     return 1;
 }
 
+/* Whether a packet of n lanes split into ns sub-packets at lens ob has
+ * every lane alone (a wavelength of its own), several of them, at a lens
+ * that is not a crystal: their gathers then go at once (gather_all). */
+static int every_lane_alone(int ns, int n, const rs_object *ob)
+{
+    return ns == n && n > 1 && !ob->u.lens.desc.uniaxial;
+}
+
 /* A lens hit of the packet lane[0..n) at lens `object` along (o, d): its
  * sub-packets (lanes of equal optics there, rs_packet_split, in the
  * frame's sub_ arrays) and their backward builds, made at once -- at a
  * dispersive lens, one lp_backward_build_many for the sub-packets'
- * wavelengths, each build exactly lp_backward_build's.  lens_next then
- * hands them out in order.  Returns -1 when out of memory. */
+ * wavelengths, each build exactly lp_backward_build's.  power: the
+ * gathers of a hit whose every lane is alone will want their power only
+ * (camera_power), so those builds make their queries' power forms
+ * (LP_BACKWARD_POWER).  lens_next then hands them out in order.  Returns
+ * -1 when out of memory. */
 static int lens_builds(const rs_integrator *it, frame *fr, const rs_object *ob, int object,
-                       const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a)
+                       const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a,
+                       int power)
 {
     int ns = rs_packet_split(it->classes, object, lane, n, fr->sub_at, fr->sub_pos, fr->sub_of,
                              fr->slot);
+    lp_trace_args pa;
+    if (power && every_lane_alone(ns, n, ob)) { /* gathered for their power alone */
+        pa = *a;
+        pa.flags |= LP_BACKWARD_POWER;
+        a = &pa;
+    }
     for (int s = 0; s < ns; s++) {
         if (s == fr->n_bws) {
             if (lp_backward_create(&fr->bws[s], NULL) != LP_OK)
@@ -1332,7 +1350,7 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
         if (!fr || !lens_args(it, level, weight, &a))
             return;
         fr->qm.valid = 0;
-        if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a) != 0)
+        if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a, 0) != 0)
             return;
         while ((m = lens_next(fr)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
@@ -1533,9 +1551,13 @@ static void shift_op(bundle *out, size_t from, double dop)
 
 /* Record the last segment of a traced ray, from o along d to the source
  * it meets at s (object `emitter`; -1 and s unused for the background);
- * its index, or -1 when out of memory. */
+ * its index, or -1 when out of memory.  In a scene where no rays
+ * interfere the table is never read (pol_values adds intensities): 0,
+ * nothing recorded. */
 static long record_wavelet(rs_worker *w, lp_vec3 o, lp_vec3 d, const rs_hit *h)
 {
+    if (!w->it->interferes)
+        return 0;
     rs_wavelet wl = {o, d, h ? h->point : o, h != NULL, h ? h->object : -1};
     return rs_wavelets_push(&w->wavelets, &wl);
 }
@@ -1853,7 +1875,7 @@ static int gather_room(frame *fr, size_t n)
  * lens that is not a crystal. */
 static int lens_single(const frame *fr, const rs_object *ob, int n)
 {
-    return fr->n_sub == n && n > 1 && !ob->u.lens.desc.uniaxial;
+    return every_lane_alone(fr->n_sub, n, ob);
 }
 
 /* Whether the rays leaving a lens hit at frame f would only be added up
@@ -1872,12 +1894,11 @@ static int camera_power(const rs_integrator *it, int f)
  * gather that fails gives nothing, as there. */
 static void gather_power_all(rs_worker *w, frame *fr, size_t nr)
 {
-    if (lp_backward_gather_power_many(fr->gm_bw, fr->gm_q, fr->gm_b, fr->gm_n, nr, &fr->res,
-                                      fr->gm_power, NULL) != LP_OK) {
+    if (lp_backward_gather_power_many(fr->gm_bw, fr->gm_q, fr->gm_b, fr->gm_n, nr, fr->gm_power,
+                                      NULL) != LP_OK) {
         for (size_t k = 0; k < nr; k++) /* one by one, to drop the failing ones */
             if (lp_backward_gather_power_many(fr->gm_bw + k, fr->gm_q + k, fr->gm_b + k,
-                                              fr->gm_n + k, 1, &fr->res, fr->gm_power + k,
-                                              NULL) != LP_OK)
+                                              fr->gm_n + k, 1, fr->gm_power + k, NULL) != LP_OK)
                 fr->gm_power[k] = 0.0;
     }
     for (size_t k = 0; k < nr; k++)
@@ -2013,7 +2034,7 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
             return;
         int split = ob->u.lens.desc.uniaxial && it->n_sources < RS_COHERENCE_MAX_SOURCES;
         fr->qm.valid = 0;
-        if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a) != 0)
+        if (lens_builds(it, fr, ob, h.object, lane, n, o, d, &a, camera_power(it, f)) != 0)
             return;
         if (lens_single(fr, ob, n)) { /* their gathers at once */
             gather_all(w, fr, &h, level, weight, f, out, start);

@@ -14,7 +14,9 @@
  *            statuses, the queries (compared as bytes), the rim depths,
  *            the filter's calls (every argument, in order) and the result
  *            of gathering two bundle rays through every query (every
- *            outgoing ray as bytes and every sum) must be identical.  The
+ *            outgoing ray as bytes and every sum, and their power alone,
+ *            lp_backward_gather_power_many, of builds with and without
+ *            LP_BACKWARD_POWER) must be identical.  The
  *            contract is exactness, so the tolerance is 0.  A query
  *            lp_backward_query_leaves says leaves its lens must have no
  *            hit of lp_lens_intersect, and both builds must say the same.
@@ -128,6 +130,14 @@ static int same_build(const lp_backward *a, const lp_backward *b, double lambda_
         for (size_t k = 0; k < ra.count; k++)
             if (!same_out_ray(&ra.rays[k], &rb.rays[k]))
                 return 0;
+        /* and their power alone (a power build's forms), bit for bit */
+        const lp_ray *pb = bundle;
+        size_t two = 2;
+        double pa = -1.0, pbw = -2.0;
+        sa = lp_backward_gather_power_many(&a, &q, &pb, &two, 1, &pa, NULL);
+        sb = lp_backward_gather_power_many(&b, &q, &pb, &two, 1, &pbw, NULL);
+        if (sa != sb || memcmp(&pa, &pbw, sizeof pa) != 0)
+            return 0;
     }
     return 1;
 }
@@ -237,8 +247,12 @@ static void test_identity(void)
             char name[128];
             snprintf(name, sizeof name, "%s, view ray %d", shapes[si].name, ri);
             identity_case(name, lens, o, d, lambda, n, &a);
+            /* for power alone (the queries' power forms) */
+            a.flags = LP_BACKWARD_POWER;
+            identity_case(name, lens, o, d, lambda, n, &a);
             /* flags, the filter and a weight cut */
             a.flags = ri % 2 ? LP_SKIP_EXTERNAL_REFLECTION : LP_SKIP_REFLECTED;
+            a.flags |= ri % 4 < 2 ? LP_BACKWARD_POWER : 0u;
             a.filter = log_filter;
             a.min_weight = ri % 3 ? 1e-3 : 0.0;
             identity_case(name, lens, o, d, lambda, n, &a);
