@@ -674,7 +674,8 @@ LP_API lp_status lp_backward_gather_many(const lp_backward *const *bw, const siz
  * node at normal incidence) is gathered by lp_backward_gather and its
  * rays' intensities added up.  Errors as lp_backward_gather_many's: the
  * first request that fails stops the call with lp_backward_gather's
- * message prefixed by "request k: ", power[0 .. k) set.  A NULL bw, q,
+ * message prefixed by "request k: ", power[0 .. k) set and power[k] 0.
+ * A NULL bw, q,
  * bundle, n or power when count > 0 gives LP_ERROR_INVALID_ARGUMENT;
  * count 0 does nothing. */
 LP_API lp_status lp_backward_gather_power_many(const lp_backward *const *bw, const size_t *q,

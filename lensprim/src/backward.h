@@ -98,7 +98,7 @@ void lp__backward_keep_form(lp_backward *bw, size_t before, const double P[3], l
 
 /* Once a build of bw is done: in the polarized mode, whose light comes
  * only by gathering, set up the ways of every gather of its queries
- * (not through a crystal). */
+ * (lp__backward_sets_ways: not through a crystal, not for power alone). */
 void lp__backward_built(lp_backward *bw);
 
 /* lp__backward_built of bw[0..n) (distinct builders), bit for bit, their
@@ -106,7 +106,8 @@ void lp__backward_built(lp_backward *bw);
 void lp__backward_built_many(lp_backward *const *bw, size_t n);
 
 /* Whether a build of bw sets up its gathers' ways (a polarized one, not
- * through a crystal), and the depth of its deepest query (0: none). */
+ * through a crystal, not with LP_BACKWARD_POWER), and the depth of its
+ * deepest query (0: none). */
 int lp__backward_sets_ways(const lp_backward *bw);
 int lp__backward_deepest(const lp_backward *bw);
 

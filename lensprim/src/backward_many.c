@@ -134,10 +134,11 @@ LP__INLINE void entry_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *
         if (power) { /* jones.h, with trace_backward.c's numbers */
             lp__cm2 R;
             lp_vec3 s, p, es, ep;
-            double ok, qok, P[3];
+            double ok, qok, P[3], ar, ai, br, bi;
             double gg = 2.0 * sqrt(g.a * g.b);
-            lp__jones_first(d, hn, g.r, g.t, g.rs, g.rp, gg * g.is, gg * g.ip, &R, &s, &p, &ok, P,
-                            &es, &ep, &qok);
+            lp__jones_reflection(g.rs, g.rp, g.tir, g.ci, W->nm[k], W->ng[k], &ar, &ai, &br, &bi);
+            lp__jones_first(d, hn, g.r, g.t, ar, ai, br, bi, gg * g.is, gg * g.ip, &R, &s, &p,
+                            &ok, P, &es, &ep, &qok);
             jones_store(W, k, &R, s, p, ok, P, lp__lane_world_dir(&K, es),
                         lp__lane_world_dir(&K, ep), qok);
         }

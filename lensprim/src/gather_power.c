@@ -8,8 +8,9 @@
  * leaves with power I x' P x / x' x, x = (v.s, v.p): s, p and the light's
  * direction are orthonormal, so (v.s, v.p) is v's part across the light
  * and its length what lp__bundle_ray_check normalizes.  A ray clear of
- * that check's limit (its part across the light more than 1e-10 of it)
- * and finite needs no more; one near it takes the check itself, so every
+ * that check's limit (its part across the light more than 1e-10 of it,
+ * against the check's 1e-12), finite and far from overflowing needs no
+ * more; one near it takes the check itself, so every
  * verdict on a ray is lp_backward_gather's.  A request without a form --
  * another build, a crystal, a way with a node at normal incidence -- is
  * gathered by lp_backward_gather and its rays' intensities added up. */
@@ -37,9 +38,11 @@ static lp_status form_power(const lp_backward *bw, size_t q, const lp_ray *b, si
         const double I0 = r->intensity;
         double x0 = v3_dot(r->vp, s), x1 = v3_dot(r->vp, p);
         double across = x0 * x0 + x1 * x1, all = v3_dot(r->vp, r->vp);
-        /* clear of lp__bundle_ray_check's limit (|across| > 1e-12 |v|),
-         * and every number finite: its verdict is sure */
-        int sure = across > 1e-20 * all && all <= DBL_MAX && isfinite(I0) && I0 >= 0.0 &&
+        /* clear of lp__bundle_ray_check's limit (a part across the light
+         * above 1e-12 of v: across > 1e-24 |v|^2) by a factor 1e4 in
+         * across, every number finite and |v| far from overflowing in
+         * the check's own arithmetic: its verdict is sure */
+        int sure = across > 1e-20 * all && all <= 0x1p1000 && isfinite(I0) && I0 >= 0.0 &&
                    isfinite(r->op) && isfinite(r->phase);
         if (!sure) {
             lp_vec3 vp;
@@ -73,9 +76,12 @@ lp_status lp_backward_gather_power_many(const lp_backward *const *bw, const size
             for (size_t i = 0; i < rays.count && st == LP_OK; i++)
                 power[k] += rays.rays[i].ray.intensity;
         }
-        if (st != LP_OK && err) {
-            lp_error e = *err;
-            lp__fail(err, st, "request %zu: %s", k, e.message);
+        if (st != LP_OK) {
+            power[k] = 0.0;
+            if (err) {
+                lp_error e = *err;
+                lp__fail(err, st, "request %zu: %s", k, e.message);
+            }
         }
     }
     lp_result_release(&rays);

@@ -127,21 +127,23 @@ LP__INLINE void lp__jones_form(const lp__cm2 *T, double P[3])
 }
 
 /* Node 1 of the view chain, entered from outside along d at the surface
- * normal n, reflected along r and refracted along t with the factors rs,
- * rp (real: from outside) and ts, tp: the light's way from node 1 (it
- * refracts out along -d) as R, the light's axes there (s_prev, p_prev)
- * and ok; the form P of the depth-1 query (the light reflecting off the
- * outside, arriving along -r), its entry axes es, ep and qok. */
-LP__INLINE void lp__jones_first(lp_vec3 d, lp_vec3 n, lp_vec3 r, lp_vec3 t, double rs, double rp,
-                                double ts, double tp, lp__cm2 *R, lp_vec3 *s_prev,
-                                lp_vec3 *p_prev, double *ok, double P[3], lp_vec3 *es,
-                                lp_vec3 *ep, double *qok)
+ * normal n, reflected along r with the factors (ar + i ai, br + i bi)
+ * (lp__jones_reflection: complex under total internal reflection, when
+ * the medium is the denser) and refracted along t with ts, tp: the
+ * light's way from node 1 (it refracts out along -d) as R, the light's
+ * axes there (s_prev, p_prev) and ok; the form P of the depth-1 query
+ * (the light reflecting off the outside, arriving along -r), its entry
+ * axes es, ep and qok. */
+LP__INLINE void lp__jones_first(lp_vec3 d, lp_vec3 n, lp_vec3 r, lp_vec3 t, double ar, double ai,
+                                double br, double bi, double ts, double tp, lp__cm2 *R,
+                                lp_vec3 *s_prev, lp_vec3 *p_prev, double *ok, double P[3],
+                                lp_vec3 *es, lp_vec3 *ep, double *qok)
 {
     lp_vec3 ap, eap;
     lp__jones_axes(v3_neg(t), n, v3_neg(d), s_prev, p_prev, &ap, ok);
     *R = lp__jones_diag(ts, 0.0, tp, 0.0);
     lp__jones_axes(v3_neg(r), n, v3_neg(d), es, ep, &eap, qok);
-    lp__cm2 T = lp__jones_diag(rs, 0.0, rp, 0.0);
+    lp__cm2 T = lp__jones_diag(ar, ai, br, bi);
     lp__jones_form(&T, P);
 }
 

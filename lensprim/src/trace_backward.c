@@ -299,10 +299,13 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
     lp__cm2 R = lp__jones_diag(0.0, 0.0, 0.0, 0.0);
     lp_vec3 s_prev = v3(0, 0, 0), p_prev = s_prev, es = s_prev, ep = s_prev;
     double jok = 0.0, qok = 0.0, P[3] = {0.0, 0.0, 0.0};
-    if (power)
-        lp__jones_first(d, h.n, lp__node_reflect_dir(&nd), lp__node_transmit_dir(&nd),
-                        creal(nd.f.rs), creal(nd.f.rp), nd.f.ts, nd.f.tp, &R, &s_prev, &p_prev,
-                        &jok, P, &es, &ep, &qok);
+    if (power) {
+        double ar, ai, br, bi;
+        lp__jones_reflection(creal(nd.f.rs), creal(nd.f.rp), nd.f.tir, nd.cos_i, o->n_medium,
+                             o->n_glass, &ar, &ai, &br, &bi);
+        lp__jones_first(d, h.n, lp__node_reflect_dir(&nd), lp__node_transmit_dir(&nd), ar, ai,
+                        br, bi, nd.f.ts, nd.f.tp, &R, &s_prev, &p_prev, &jok, P, &es, &ep, &qok);
+    }
     size_t before = bw->n_queries;
     lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, lp__node_reflect_dir(&nd), 1u, 0.0,
                            node_bound(&nd, mode, 1), node_weight(&nd, mode, 1));

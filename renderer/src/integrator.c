@@ -1913,8 +1913,11 @@ static void gather_power_all(rs_worker *w, frame *fr, size_t nr)
  * all of them gathered in one lp_backward_gather_many, which carries the
  * rays of many wavelengths side by side, and the outputs appended to out
  * in the same order, their optical paths then counted from the ray's
- * origin (shift_op, by h->t).  A gather that fails gives nothing, as
- * there; out of memory, the branch stops where it is, as there. */
+ * origin (shift_op, by h->t) -- or, at the camera ray's own hit where
+ * nothing interferes (camera_power: builds made for power alone), their
+ * power alone added to the pixel's lanes (gather_power_all), nothing
+ * appended to out.  A gather that fails gives nothing, as there; out of
+ * memory, the branch stops where it is, as there. */
 static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, double weight,
                        int f, bundle *out, size_t start)
 {

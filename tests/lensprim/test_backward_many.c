@@ -5,7 +5,7 @@
  *            catalog glasses with absorption, one in a dispersive medium,
  *            a ball whose chains totally reflect inside, a flat plate seen
  *            along its axis, a conical rim, a knife edge, a uniaxial
- *            crystal), every mode, depths 1, 2, 5 and 12, flags, a filter
+ *            crystal, a lens in a denser medium), every mode, depths 1, 2, 5 and 12, flags, a filter
  *            and min_weight, and view rays of every kind (from both sides,
  *            along the axis, grazing, at the rim, from points on the lens,
  *            missing it): n builders are built by lp_backward_build_many
@@ -200,6 +200,8 @@ static void test_identity(void)
         {"conical rim n=1.6", 60, -30, 6, 24, 18, NULL, 1.6, NULL, 0, 0},
         {"knife edge n=1.5", 20, -20, 2 * (20 - sqrt(400 - 100)), 20, 0, NULL, 1.5, NULL, 0, 0},
         {"crystal plate", 0, 0, 3, 20, 0, NULL, 0, NULL, 1, 0},
+        /* in a denser medium: total internal reflection off the outside */
+        {"biconvex n=1.3 in N-SF11", 40, -40, 6, 24, 0, NULL, 1.3, "N-SF11", 0, 0},
     };
     const size_t counts[] = {1, 3, 16, 17, 40};
     const int depths[] = {1, 2, 5, 12};

@@ -5,8 +5,12 @@
  * identity   For placed and tilted lenses of every kind (dispersive
  *            catalog glasses with absorption, one in a dispersive medium,
  *            a ball whose chains totally reflect inside, a flat plate seen
- *            along its axis, a conical rim, a uniaxial crystal), view rays
- *            of every kind, depths 1, 2, 5, 12 and 16, builders of 16
+ *            along its axis, a conical rim, a uniaxial crystal, a lens
+ *            in a denser medium), view rays
+ *            of every kind (some through the front cap's centre of
+ *            curvature: normal incidence at their first node; some
+ *            steeply onto the front vertex), depths
+ *            1, 2, 5, 12 and 16, builders of 16
  *            wavelengths (lp_backward_build_many) in the polarized mode
  *            and some in the fresnel mode: requests through every query
  *            of every builder, in builder order or interleaved, with
@@ -65,8 +69,9 @@ static double worst_power;
 
 /* A bundle ray arriving back along the world direction qd (lambda_nm):
  * a random field direction, or one that fails (bad 1: an intensity that
- * is not a number, 2: a field along the light) or may (3: a field within
- * a few 1e-12 of the light's direction). */
+ * is not a number, 2: a field along the light, 4: an intensity negative
+ * or infinite, 5: an infinite optical path or a phase not a number) or
+ * may (3: a field within a few 1e-12 of the light's direction). */
 static lp_ray bundle_ray(lp_vec3 qd, double lambda_nm, int bad)
 {
     lp_ray r;
@@ -84,7 +89,14 @@ static lp_ray bundle_ray(lp_vec3 qd, double lambda_nm, int bad)
         r.intensity = NAN;
     else if (bad == 2)
         r.vp = qd;
-    else if (bad == 3) { /* near the check's limit: a part across the light of
+    else if (bad == 4)
+        r.intensity = uniform() < 0.5 ? -1.0 : INFINITY;
+    else if (bad == 5) {
+        if (uniform() < 0.5)
+            r.op = INFINITY;
+        else
+            r.phase = NAN;
+    } else if (bad == 3) { /* near the check's limit: a part across the light of
                           * 0.3e-12 .. 3e-12 of the field (it fails below 1e-12) */
         lp_vec3 a = fabs(qd.x) < 0.9 ? vec(1, 0, 0) : vec(0, 1, 0);
         lp_vec3 c = vec(qd.y * a.z - qd.z * a.y, qd.z * a.x - qd.x * a.z, qd.x * a.y - qd.y * a.x);
@@ -94,26 +106,6 @@ static lp_ray bundle_ray(lp_vec3 qd, double lambda_nm, int bad)
     return r;
 }
 
-/* lp_backward_gather_power_many of the requests of [from, count), whose
- * gathers one by one fail at `failed` (count: none) with sa and message
- * want: the same status and message, no ray stored, each request's power
- * the sum of the intensities of the rays its gather appends (the failing
- * one's before its failing ray), and the sums of those gathers (made
- * again here into a result of their own).
- *
- * The tolerance: every factor of a way (Fresnel's power-normalized
- * amplitudes, the axes' cosines, the segments' attenuations) is at most
- * 1 in size, so each rounding of a ray's amplitude is at most eps
- * (2^-53) of the ray's own amplitude; a way of k <= 16 nodes takes about
- * 10 of them a node in either computation (3-vectors projected and
- * rebuilt, or 2 x 2 products), and a request adds up at most 20 rays: at
- * most 2 (10 x 16 + 20) eps = 4.0e-14 of the bundle's intensity apart
- * A field direction v given to
- * rounding (eps |v|) has its part across the light known to eps |v| too,
- * so a ray whose v is within a fraction f of the light's direction (the
- * rays near the check's limit, f ~ 1e-12) has its direction across the
- * light, and its power, known to about 2 eps / f: both computations may
- * differ by twice that, 4 eps / f of its intensity. */
 /* The part of v across the unit d, over |v| (0 for a zero v). */
 static double across(lp_vec3 v, lp_vec3 d)
 {
@@ -122,6 +114,25 @@ static double across(lp_vec3 v, lp_vec3 d)
     return l > 0.0 ? sqrt(c.x * c.x + c.y * c.y + c.z * c.z) / l : 0.0;
 }
 
+/* lp_backward_gather_power_many of the requests of [from, count), whose
+ * gathers one by one fail at `failed` (count: none) with sa and message
+ * want: the same status and message, and each request's power before the
+ * failing one the sum of the intensities of the rays its gather appends
+ * (made again here), the failing one's 0.
+ *
+ * The tolerance: every factor of a way (Fresnel's power-normalized
+ * amplitudes, the axes' cosines, the segments' attenuations) is at most
+ * 1 in size, so each rounding of a ray's amplitude is at most eps
+ * (2^-53) of the ray's own amplitude; a way of k <= 16 nodes takes about
+ * 10 of them a node in either computation (3-vectors projected and
+ * rebuilt, or 2 x 2 products), and a request adds up at most 20 rays: at
+ * most 2 (10 x 16 + 20) eps = 4.0e-14 of the bundle's intensity apart.
+ * A field direction v given to rounding (eps |v|) has its part across
+ * the light known to eps |v| too, so a ray whose v is within a fraction f
+ * of the light's direction (the rays near the check's limit, f ~ 1e-12)
+ * has its direction across the light, and its power, known to about 2
+ * eps / f: both computations may differ by twice that, 4 eps / f of its
+ * intensity. */
 static void power_from(const char *name, size_t from, size_t count, size_t failed, lp_status sa,
                        const char *want)
 {
@@ -158,6 +169,9 @@ static void power_from(const char *name, size_t from, size_t count, size_t faile
         worst_power = e > worst_power ? e : worst_power;
         n_power++;
     }
+    if (failed < count)
+        CHECK(power[failed - from] == 0.0, "%s: power: the failing request's is %g", name,
+              power[failed - from]);
 }
 
 /* The requests k of [from, count) one by one into a, the many call into
@@ -227,7 +241,7 @@ static void gather_case(const char *name, size_t nb, const double *lambda, int i
         double u = uniform();
         size_t n = u < 0.05 ? 0 : u < 0.6 ? 2 : u < 0.8 ? 1 : (size_t)(MAX_RAYS * uniform());
         for (size_t i = 0; i < n; i++)
-            rays[count][i] = bundle_ray(qd, lambda[s], bad && uniform() < 0.02 ? 1 + (int)(3.0 * uniform()) : 0);
+            rays[count][i] = bundle_ray(qd, lambda[s], bad && uniform() < 0.02 ? 1 + (int)(5.0 * uniform()) : 0);
         req_bw[count] = bws[s];
         req_q[count] = j;
         req_n[count] = n;
@@ -267,6 +281,8 @@ static void test_identity(void)
         {"conical rim n=1.6", 60, -30, 6, 24, 18, NULL, 1.6, NULL, 0, 0},
         {"biconcave SF11", -30, 30, 3, 22, 0, "N-SF11", 0, NULL, 0, 0},
         {"crystal plate", 0, 0, 3, 20, 0, NULL, 0, NULL, 1, 0},
+        /* in a denser medium: total internal reflection off the outside */
+        {"biconvex n=1.3 in N-SF11", 40, -40, 6, 24, 0, NULL, 1.3, "N-SF11", 0, 0},
     };
     const int depths[] = {1, 2, 5, 12, 16};
     lp_error err;
@@ -278,7 +294,9 @@ static void test_identity(void)
         if (placed_lens(&shapes[si], si, &lens, &desc, &u, &v, &w) != 0)
             continue;
         double h = 0.5 * desc.diameter, t = desc.thickness;
-        for (int ri = 0; ri < 24; ri++) {
+        for (int ri = 0; ri < 30; ri++) {
+            if (ri >= 24 && ri < 28 && shapes[si].r1 == 0.0)
+                continue; /* a flat cap has no centre */
             lp_vec3 o, d;
             int kind = ri % 4;
             if (kind == 0) { /* along the axis, from the front */
@@ -292,6 +310,21 @@ static void test_identity(void)
                 d = place(vec(0, 0, 0), u, v, w, sin(tilt) * cos(az), sin(tilt) * sin(az),
                           (side < 0.0 ? 1.0 : -1.0) * cos(tilt));
             }
+            if (ri >= 28) { /* steeply onto the front vertex: past the critical angle
+                             * of a lens in a denser medium */
+                double th = 1.0 + 0.4 * uniform();
+                d = place(vec(0, 0, 0), u, v, w, 0, sin(th), cos(th));
+                lp_vec3 X = desc.position;
+                o = vec(X.x - 3.0 * h * d.x, X.y - 3.0 * h * d.y, X.z - 3.0 * h * d.z);
+            } else if (ri >= 24) { /* through the front cap's centre: normal incidence there */
+                lp_vec3 C = place(desc.position, u, v, w, 0, 0, desc.radius1);
+                d = place(vec(0, 0, 0), u, v, w, 0.3 * (2.0 * uniform() - 1.0),
+                          0.3 * (2.0 * uniform() - 1.0), 1.0);
+                double dl = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+                d = vec(d.x / dl, d.y / dl, d.z / dl);
+                double back = (desc.radius1 > 0.0 ? desc.radius1 : 0.0) + 3.0 * h;
+                o = vec(C.x - back * d.x, C.y - back * d.y, C.z - back * d.z);
+            }
             double lambda[NW];
             for (size_t k = 0; k < NW; k++)
                 lambda[k] = 400.0 + 300.0 * uniform();
@@ -300,6 +333,10 @@ static void test_identity(void)
             a.mode = ri % 6 == 5 ? LP_MODE_FRESNEL : LP_MODE_POLARIZED;
             if (ri % 3 != 1) /* the builds for power alone (ignored by fresnel's) */
                 a.flags |= LP_BACKWARD_POWER;
+            if (ri >= 24) { /* the special view rays: for power alone */
+                a.mode = LP_MODE_POLARIZED;
+                a.flags |= LP_BACKWARD_POWER;
+            }
             a.max_depth = depths[ri % 5];
             size_t nb = ri % 5 == 4 ? 3 : NW;
             CHECK(lp_backward_build_many(bws, nb, lens, o, d, lambda, &a, &err) == LP_OK,
@@ -357,8 +394,9 @@ static void test_errors(void)
               LP_ERROR_INVALID_ARGUMENT,
           "power: NULL builders");
     CHECK(power == 7.0, "power: nothing done before the arguments check out");
-    CHECK(lp_backward_gather_power_many(NULL, NULL, NULL, NULL, 0, NULL, &err) == LP_OK,
-          "power: count = 0: nothing to do");
+    CHECK(lp_backward_gather_power_many(NULL, NULL, NULL, NULL, 0, NULL, &err) == LP_OK &&
+              err.status == LP_OK && err.message[0] == '\0',
+          "power: count = 0: nothing to do, err cleared");
     lp_result_release(&r);
 }
 
