@@ -1923,7 +1923,7 @@ static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, doub
 {
     const rs_scene *sc = w->it->scene;
     size_t nr = 0;
-    int m;
+    int m, power = camera_power(w->it, f);
     while ((m = lens_next(fr)) > 0) { /* m is 1 */
         size_t nq = lp_backward_query_count(fr->bw);
         const lp_query *q = lp_backward_queries(fr->bw);
@@ -1939,7 +1939,8 @@ static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, doub
                           weight * q[j].bound, f + 1, c);
             if (c->n == 0)
                 continue;
-            w->work.gathered += (double)c->n;
+            if (!power) /* a ray's power alone costs about a multiplication */
+                w->work.gathered += (double)c->n;
             fr->gm_bw[nr] = fr->bw;
             fr->gm_q[nr] = j;
             fr->gm_b[nr] = c->r;
@@ -1949,7 +1950,7 @@ static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, doub
         }
     }
     lp_result_clear(&fr->res);
-    if (camera_power(w->it, f)) {
+    if (power) {
         gather_power_all(w, fr, nr);
         return;
     }

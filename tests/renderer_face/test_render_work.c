@@ -4,8 +4,10 @@
  * one ray per camera ray (aa x aa per pixel), each carrying every lane
  * (3 in rgb, N wavelengths in the spectral modes), with no lens builds and
  * nothing gathered.  A lens scene in every mode: more rays than camera
- * rays, lens builds, rays gathered in the polarized mode, a positive
- * price; the counts are whole numbers and the same on 1, 2 and 3 threads,
+ * rays, lens builds, a positive price, no rays gathered but in the
+ * polarized mode -- and there none either, the dispersive lens's every
+ * hit being the camera ray's own, where each wavelength's power alone is
+ * gathered, but some without dispersion; the counts are whole numbers and the same on 1, 2 and 3 threads,
  * and the counts of regions that cut the image add up to the whole
  * image's.  A bad argument gives zero counts. */
 #include <math.h>
@@ -51,6 +53,9 @@ static lr_scene *load(const char *text)
     return s;
 }
 
+/* Dispersion off in the renders of work_of (lr_render_opts.no_dispersion). */
+static int no_dispersion;
+
 /* Render region [x0,x1) x [y0,y1) of scene s; 0, or -1 on failure. */
 static int work_of(lr_scene *s, lr_mode mode, int wavelengths, int aa, int threads, int x0,
                    int y0, int x1, int y1, lr_work *wk)
@@ -61,6 +66,7 @@ static int work_of(lr_scene *s, lr_mode mode, int wavelengths, int aa, int threa
     float *rgb = malloc(sizeof *rgb * 3 * W * H);
     int rc = -1;
     lr_render_opts_init(&o);
+    o.no_dispersion = no_dispersion;
     o.mode = mode;
     o.width = W;
     o.height = H;
@@ -150,8 +156,10 @@ static void lens_scene(void)
         CHECK(one.lane_rays >= one.rays, "%s: lane_rays %g >= rays %g", name, one.lane_rays,
               one.rays);
         CHECK(one.builds > 0.0, "%s: lens builds %g > 0", name, one.builds);
-        if (modes[m] == LR_MODE_POLARIZED)
-            CHECK(one.gathered > 0.0, "%s: gathered %g > 0", name, one.gathered);
+        if (modes[m] == LR_MODE_POLARIZED) /* every lens hit the camera ray's own, each
+                                              wavelength alone: their power alone */
+            CHECK(one.gathered == 0.0, "%s: gathered %g == 0 (power alone)", name,
+                  one.gathered);
         else
             CHECK(one.gathered == 0.0, "%s: gathered %g == 0 (polarized only)", name,
                   one.gathered);
@@ -182,6 +190,24 @@ static void lens_scene(void)
     lr_scene_free(s);
 }
 
+/* Without dispersion the lens keeps the packet whole, and its rays are
+ * gathered, not their power alone: counted in the polarized mode. */
+static void lens_scene_no_dispersion(void)
+{
+    lr_scene *s = load(lens_text); /* its own: no_dispersion changes it for good */
+    lr_work one;
+    CHECK(s != NULL, "the lens scene loads");
+    if (!s)
+        return;
+    no_dispersion = 1;
+    if (work_of(s, LR_MODE_POLARIZED, 8, 1, 1, 0, 0, W, H, &one) == 0)
+        CHECK(one.gathered > 0.0, "no dispersion, polarized: gathered %g > 0", one.gathered);
+    else
+        CHECK(0, "no dispersion, polarized: renders");
+    no_dispersion = 0;
+    lr_scene_free(s);
+}
+
 static void bad_argument(void)
 {
     lr_work wk;
@@ -198,6 +224,7 @@ int main(void)
 {
     empty_scene();
     lens_scene();
+    lens_scene_no_dispersion();
     bad_argument();
     return check_finish("test_render_work");
 }

@@ -318,7 +318,11 @@ typedef struct lr_work {
     double lane_rays; /* the spectral lanes those rays carried, summed */
     double builds;    /* lens hits' backward builds (one per sub-packet of
                          equal optics) */
-    double gathered;  /* rays gathered back through lenses (polarized) */
+    double gathered;  /* rays gathered back through lenses (polarized),
+                         but for those whose power alone is gathered
+                         (at the camera ray's hit of a dispersive lens
+                         where nothing interferes: about a
+                         multiplication each) */
     double cost;      /* the automatic mode's price of these counts in the
                          mode rendered: a linear model of them in
                          instructions of this renderer, fitted to
