@@ -90,7 +90,7 @@ LP__INLINE void factors(lp_mode mode, double r0, double n1, double n2, const lp_
     double Rf = lp__lane_reflectance(0, 0.0, 0, g); /* Fresnel's */
     if (mode == LP_MODE_POLARIZED) {
         double Rs = g->rs * g->rs, Rp = g->rp * g->rp;
-        double gg = 2.0 * sqrt(g->a * g->b), ts = gg * g->is, tp = gg * g->ip;
+        double ts = g->ts, tp = g->tp;
         double ts2 = ts * ts, tp2 = tp * tp;
         *bR = g->tir ? 1.0 : lp__max(Rs, Rp);
         *bT = g->tir ? 0.0 : lp__max(ts2, tp2);
@@ -135,9 +135,8 @@ LP__INLINE void entry_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *
             lp__cm2 R;
             lp_vec3 s, p, es, ep;
             double ok, qok, P[3], ar, ai, br, bi;
-            double gg = 2.0 * sqrt(g.a * g.b);
             lp__jones_reflection(g.rs, g.rp, g.tir, g.ci, W->nm[k], W->ng[k], &ar, &ai, &br, &bi);
-            lp__jones_first(d, hn, g.r, g.t, ar, ai, br, bi, gg * g.is, gg * g.ip, &R, &s, &p,
+            lp__jones_first(d, hn, g.r, g.t, ar, ai, br, bi, g.ts, g.tp, &R, &s, &p,
                             &ok, P, &es, &ep, &qok);
             jones_store(W, k, &R, s, p, ok, P, lp__lane_world_dir(&K, es),
                         lp__lane_world_dir(&K, ep), qok);
@@ -217,10 +216,9 @@ LP__INLINE void node_step(wl_lanes *restrict W, size_t n, const lp__lane_lens *K
             lp__cm2 R;
             lp_vec3 s, p, es, ep;
             double ok, qok, P[3], ar, ai, br, bi;
-            double gg = 2.0 * sqrt(g.a * g.b);
             jones_load(W, k, &R, &s, &p, &ok);
             lp__jones_reflection(g.rs, g.rp, g.tir, g.ci, W->ng[k], W->nm[k], &ar, &ai, &br, &bi);
-            lp__jones_node(d, nrm, g.r, g.t, 1.0 + m, gg * g.is, gg * g.ip, ar, ai, br, bi, &R, &s,
+            lp__jones_node(d, nrm, g.r, g.t, 1.0 + m, g.ts, g.tp, ar, ai, br, bi, &R, &s,
                            &p, &ok, P, &es, &ep, &qok);
             jones_store(W, k, &R, s, p, ok, P, lp__lane_world_dir(&K, es),
                         lp__lane_world_dir(&K, ep), qok);

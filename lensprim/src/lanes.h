@@ -238,6 +238,7 @@ typedef struct lp__lane_node {
     double a, b, c, d; /* n1 ci, n2 ct, n2 ci, n1 ct */
     double is, ip;     /* 1/(a + b), 1/(c + d) */
     double rs, rp;     /* amplitude reflection coefficients */
+    double ts, tp;     /* power-normalized transmission amplitudes */
     int tir;
     lp_vec3 t, r;      /* transmitted and reflected directions */
 } lp__lane_node;
@@ -253,15 +254,21 @@ LP__INLINE void lp__lane_node_raw(double n1, double n2, double eta, lp_vec3 d, l
     double ci = adn < 1.0 ? adn : 1.0;
     double sin2_i = (1.0 - ci) * (1.0 + ci);
     double cos2_t = 1.0 - eta * eta * sin2_i;
-    double ct = sqrt(cos2_t);
+    /* no interface at all where the indices are equal: the light goes on
+     * (fresnel.h's lp__fresnel_eval: cos t = cos i, ts = tp = 1) */
+    int same = n1 == n2;
+    double ct = same ? ci : sqrt(cos2_t);
     g->ci = ci;
     g->ct = ct;
-    g->tir = cos2_t < 0.0;
+    g->tir = !same & (cos2_t < 0.0);
     g->a = n1 * ci, g->b = n2 * ct;
     g->c = n2 * ci, g->d = n1 * ct;
     g->is = 1.0 / (g->a + g->b), g->ip = 1.0 / (g->c + g->d);
     g->rs = (g->a - g->b) * g->is;
     g->rp = (g->c - g->d) * g->ip;
+    double gg = 2.0 * sqrt(g->a * g->b); /* 2 sqrt(n1 ci n2 ct) */
+    g->ts = same ? 1.0 : gg * g->is;
+    g->tp = same ? 1.0 : gg * g->ip;
     g->t = v3_madd(v3_scale(d, eta), g->nn, eta * ci - ct);
     g->r = v3_madd(d, g->nn, 2.0 * ci);
 }

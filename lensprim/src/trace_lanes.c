@@ -89,6 +89,7 @@ struct lp__lanes {
     double grx[NL], gry[NL], grz[NL]; /* reflected direction */
     double gsx[NL], gsy[NL], gsz[NL]; /* the s axis */
     double ga[NL], gb[NL], gis[NL], gip[NL], grs[NL], grp[NL], gci[NL], gct[NL];
+    double gts[NL], gtp[NL];
     double gtir[NL], godd[NL];
     double *node;                  /* [depth][NF][NL] for depths 2.. */
 };
@@ -171,6 +172,7 @@ LP__INLINE void geom(lp__lanes *restrict L, size_t c, double n1, double n2, doub
     L->gsx[c] = s.x, L->gsy[c] = s.y, L->gsz[c] = s.z;
     L->ga[c] = g.a, L->gb[c] = g.b;
     L->gis[c] = g.is, L->gip[c] = g.ip;
+    L->gts[c] = g.ts, L->gtp[c] = g.tp;
     L->grs[c] = g.rs, L->grp[c] = g.rp;
     L->gci[c] = g.ci, L->gct[c] = g.ct;
     L->gtir[c] = g.tir ? 1.0 : 0.0;
@@ -196,6 +198,7 @@ LP__INLINE void fields(const lp__lanes *restrict L, size_t c, int law, double r0
     lp__lane_node g;
     g.a = L->ga[c], g.b = L->gb[c];
     g.is = L->gis[c], g.ip = L->gip[c];
+    g.ts = L->gts[c], g.tp = L->gtp[c];
     g.rs = L->grs[c], g.rp = L->grp[c];
     g.ci = L->gci[c], g.ct = L->gct[c];
     g.tir = L->gtir[c] != 0.0;
@@ -210,10 +213,9 @@ LP__INLINE void fields(const lp__lanes *restrict L, size_t c, int law, double r0
     /* the amplitudes on s and p: transmitted (t), reflected (r) */
     double ts_, tp_, tsi, tpi, rs_, rp_, rsi, rpi;
     if (law == LP__LAW_POLARIZED) {
-        double g2 = 2.0 * sqrt(g.a * g.b);
         double mirror = g.rs * (es * es + esi * esi) - g.rp * (ep * ep + epi * epi);
         int flip = mirror < 0.0;
-        double gs = g2 * g.is, gp = g2 * g.ip;
+        double gs = g.ts, gp = g.tp;
         double ks = flip ? -g.rs : g.rs, kp = flip ? -g.rp : g.rp;
         double ki = flip ? -0.0 : 0.0; /* the imaginary part of +-rs, +-rp */
         o->flip = flip ? 1.0 : 0.0;

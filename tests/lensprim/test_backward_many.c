@@ -5,7 +5,8 @@
  *            catalog glasses with absorption, one in a dispersive medium,
  *            a ball whose chains totally reflect inside, a flat plate seen
  *            along its axis, a conical rim, a knife edge, a uniaxial
- *            crystal, a lens in a denser medium), every mode, depths 1, 2, 5 and 12, flags, a filter
+ *            crystal, a lens in a denser medium, one index-matched to
+ *            its medium), every mode, depths 1, 2, 5 and 12, flags, a filter
  *            and min_weight, and view rays of every kind (from both sides,
  *            along the axis, grazing, at the rim, from points on the lens,
  *            missing it): n builders are built by lp_backward_build_many
@@ -202,6 +203,8 @@ static void test_identity(void)
         {"crystal plate", 0, 0, 3, 20, 0, NULL, 0, NULL, 1, 0},
         /* in a denser medium: total internal reflection off the outside */
         {"biconvex n=1.3 in N-SF11", 40, -40, 6, 24, 0, NULL, 1.3, "N-SF11", 0, 0},
+        /* index-matched: no interface at the caps (fresnel.h's n1 == n2) */
+        {"N-BK7 in N-BK7", 30, -40, 5, 20, 0, "N-BK7", 0, "N-BK7", 0, 0},
     };
     const size_t counts[] = {1, 3, 16, 17, 40};
     const int depths[] = {1, 2, 5, 12};

@@ -3,8 +3,8 @@
  *
  * identity   For placed and tilted lenses of every kind (biconvex
  *            catalog glass with absorption, meniscus, flat plate,
- *            conical rim, knife edge, a lens in a denser medium, a
- *            uniaxial crystal), every mode, depths 1, 5 and 20, flags, a
+ *            conical rim, knife edge, a lens in a denser medium, one
+ *            index-matched to its medium, a uniaxial crystal), every mode, depths 1, 5 and 20, flags, a
  *            filter and min_weight: random rays -- hits, rays grazing the
  *            lens's bounding sphere, rays from the far side, rays starting
  *            on the lens (its own outgoing rays fed back), rays that meet
@@ -338,6 +338,8 @@ static void test_identity(void)
         {"knife edge", 20, -20, 2 * (20 - sqrt(400 - 100)), 20, 0, 1.5, 0, 0},
         {"ball-like n=1.9", 10, -10, 19, 19.9, 0, 1.9, 0, 0},
         {"n=1.5 in a medium n=1.8", 30, -40, 5, 20, 0, 1.5, 0, 1.8},
+        /* index-matched: no interface at the caps (fresnel.h's n1 == n2) */
+        {"n=1.5 in a medium n=1.5", 30, -40, 5, 20, 0, 1.5, 0, 1.5},
         {"calcite-like crystal plate", 0, 0, 3, 20, 0, 0, 1, 0},
     };
     lp_mode modes[] = {LP_MODE_POLARIZED, LP_MODE_FRESNEL, LP_MODE_SCHLICK};
