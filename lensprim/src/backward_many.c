@@ -442,14 +442,19 @@ static void build_group(lp_backward *const *bw, size_t n, const lp_lens *lens,
                 int surface = b->node[j].surface;
                 lp_kind kind = j == 1 || surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT;
                 size_t before = b->n_queries;
-                double P[3] = {b->pform[j - 1][0], b->pform[j - 1][1], b->pform[j - 1][2]};
-                lp_vec3 es = b->pform_s[j - 1], ep = b->pform_p[j - 1];
-                double ok = b->pform_ok[j - 1];
-                lp__backward_add_query_at(b, j, kind, surface, b->query_dir[j - 1], q->origin,
-                                          q->dir, j == 1 ? 1u : path, q->op, q->bound,
-                                          q->weight, b->leaves[j - 1]);
-                if (power)
+                if (!power) {
+                    lp__backward_add_query_at(b, j, kind, surface, b->query_dir[j - 1],
+                                              q->origin, q->dir, j == 1 ? 1u : path, q->op,
+                                              q->bound, q->weight, b->leaves[j - 1]);
+                } else { /* its form read before the query may take its slot */
+                    double P[3] = {b->pform[j - 1][0], b->pform[j - 1][1], b->pform[j - 1][2]};
+                    lp_vec3 es = b->pform_s[j - 1], ep = b->pform_p[j - 1];
+                    double ok = b->pform_ok[j - 1];
+                    lp__backward_add_query_at(b, j, kind, surface, b->query_dir[j - 1],
+                                              q->origin, q->dir, j == 1 ? 1u : path, q->op,
+                                              q->bound, q->weight, b->leaves[j - 1]);
                     lp__backward_keep_form(b, before, P, es, ep, ok);
+                }
             }
             if (j > 1)
                 path |= (uint64_t)1 << (j - 1);
