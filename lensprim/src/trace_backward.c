@@ -299,15 +299,16 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
     lp__cm2 R = lp__jones_diag(0.0, 0.0, 0.0, 0.0);
     lp_vec3 s_prev = v3(0, 0, 0), p_prev = s_prev, es = s_prev, ep = s_prev;
     double jok = 0.0, qok = 0.0, P[3] = {0.0, 0.0, 0.0};
+    lp_vec3 r = lp__node_reflect_dir(&nd), t = lp__node_transmit_dir(&nd);
     if (power) {
         double ar, ai, br, bi;
         lp__jones_reflection(creal(nd.f.rs), creal(nd.f.rp), nd.f.tir, nd.cos_i, o->n_medium,
                              o->n_glass, &ar, &ai, &br, &bi);
-        lp__jones_first(d, h.n, lp__node_reflect_dir(&nd), lp__node_transmit_dir(&nd), ar, ai,
-                        br, bi, nd.f.ts, nd.f.tp, &R, &s_prev, &p_prev, &jok, P, &es, &ep, &qok);
+        lp__jones_first(d, h.n, r, t, ar, ai, br, bi, nd.f.ts, nd.f.tp, &R, &s_prev, &p_prev,
+                        &jok, P, &es, &ep, &qok);
     }
     size_t before = bw->n_queries;
-    lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, lp__node_reflect_dir(&nd), 1u, 0.0,
+    lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, r, 1u, 0.0,
                            node_bound(&nd, mode, 1), node_weight(&nd, mode, 1));
     if (power && bw->n_queries > before)
         lp__backward_keep_form(bw, before, P, lp__to_world_dir(lens, es),
@@ -320,7 +321,7 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
     double bound = node_bound(&nd, mode, 0), weight = node_weight(&nd, mode, 0), op = 0.0;
     uint64_t path = 0;
     int depth = 1;
-    d = lp__node_transmit_dir(&nd);
+    d = t;
     p = h.p;
     int surface = h.surface;
     bw->node[1].e_out = d;
@@ -348,19 +349,19 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
         bw->node[depth].n = h.n;
         bw->node[depth].surface = h.surface;
         tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_glass, o->n_medium);
+        r = lp__node_reflect_dir(&nd), t = lp__node_transmit_dir(&nd);
         if (power) {
             double ar, ai, br, bi;
             lp__jones_reflection(creal(nd.f.rs), creal(nd.f.rp), nd.f.tir, nd.cos_i, o->n_glass,
                                  o->n_medium, &ar, &ai, &br, &bi);
-            lp__jones_node(d, h.n, lp__node_reflect_dir(&nd), lp__node_transmit_dir(&nd), 1.0 + m,
-                           nd.f.ts, nd.f.tp, ar, ai, br, bi, &R, &s_prev, &p_prev, &jok, P, &es,
-                           &ep, &qok);
+            lp__jones_node(d, h.n, r, t, 1.0 + m, nd.f.ts, nd.f.tp, ar, ai, br, bi, &R, &s_prev,
+                           &p_prev, &jok, P, &es, &ep, &qok);
         }
         before = bw->n_queries;
         if (!tir)
             lp__backward_add_query(bw, depth,
                                    h.surface == entry ? LP_KIND_REFLECT : LP_KIND_TRANSMIT,
-                                   h.surface, lp__node_transmit_dir(&nd), path, op,
+                                   h.surface, t, path, op,
                                    bound * node_bound(&nd, mode, 0),
                                    weight * node_weight(&nd, mode, 0));
         if (power && bw->n_queries > before)
@@ -369,7 +370,7 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
         bound *= node_bound(&nd, mode, 1);
         weight *= node_weight(&nd, mode, 1);
         path |= (uint64_t)1 << (depth - 1);
-        d = lp__node_reflect_dir(&nd);
+        d = r;
         p = h.p;
         surface = h.surface;
         bw->node[depth].e_out = d;
