@@ -484,7 +484,12 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
             double power = -1.0;
             stt = lp_backward_gather_power_many(&pb, &pq, &pbundle, &pn, 1, &power, &err);
             CHECK(stt == LP_OK, "%s: gather_power: %s", ctx, err.message);
-            CHECK_REL(power, g.out, 1e-12, "%s: gather_power against the gather's rays", ctx);
+            /* both carry the field through k <= 6 nodes, about 10 roundings a
+             * node each, every factor at most 1 in size: apart by at most
+             * 2 (10 x 6 + 2) eps of the bundle's intensity = 1.4e-14
+             * (measured: 1.8e-14 of the power itself, less of the bundle's) */
+            CHECK_ABS(power, g.out, 2.0 * (10.0 * 6.0 + 2.0) * 0x1p-53 * bsum,
+                      "%s: gather_power against the gather's rays", ctx);
             ref_real exact_sum = 0;
             int n_exact = 0, tir_here = 0;
             for (size_t i = 0; i < g.count; i++) {
@@ -599,6 +604,9 @@ static void one_lens(int li, lp_backward *bw, lp_mode mode, stats *S)
                 }
             }
             if (n_exact == 2) { /* the power against the exact Jones (or Fresnel) chain's */
+                /* the tolerance of the gathered intensity against the exact
+                 * chain, above, which this power equals to 1.4e-14 (measured
+                 * worst here 1.1e-13 relative) */
                 CHECK_REL(power, (double)exact_sum, 1e-10, "%s: gather_power vs exact", ctx);
                 S->power_compared++;
                 S->power_tir += tir_here;
