@@ -205,10 +205,13 @@ static int may_see_lens(const rs_scene *s, const lens_boxes *lb, lp_vec3 o, lp_v
 /* Render the pixels px[2k], px[2k + 1] of the groups of sizes n[0..ng)
  * (one after another) with opts into out; the cost of each group's
  * renders (rs_work_cost) into gcost[g], their work into gwork[g] (when
- * not NULL) and the costs' sum added to *spent. */
+ * not NULL) and the costs' sum added to *spent.  When not NULL, pcost[k]
+ * gets pixel k's own cost and split[k] whether its spectral packet split
+ * at a lens (rs_worker_splits). */
 static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const int *px,
                          const size_t *n, int ng, rs_color *out, double *gcost, rs_work *gwork,
-                         double *spent, char *msg, size_t msg_size)
+                         double *pcost, unsigned char *split, double *spent, char *msg,
+                         size_t msg_size)
 {
     rs_integrator *it;
     rs_worker *w;
@@ -223,8 +226,20 @@ static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const in
         return -1;
     }
     for (int g = 0; g < ng; g++) {
-        for (size_t m = 0; m < n[g]; m++, k++)
+        for (size_t m = 0; m < n[g]; m++, k++) {
+            rs_work pb, pa;
+            unsigned long long s0 = rs_worker_splits(w);
+            rs_worker_work(w, &pb);
             rs_integrator_pixel(it, w, px[2 * k], px[2 * k + 1], &out[k]);
+            rs_worker_work(w, &pa);
+            if (pcost) {
+                rs_work d = {pa.rays - pb.rays, pa.lane_rays - pb.lane_rays,
+                             pa.builds - pb.builds, pa.gathered - pb.gathered};
+                pcost[k] = rs_work_cost(&d, opts->mode, 1.0);
+            }
+            if (split)
+                split[k] = rs_worker_splits(w) != s0;
+        }
         rs_worker_work(w, &after);
         rs_work d = {after.rays - before.rays, after.lane_rays - before.lane_rays,
                      after.builds - before.builds, after.gathered - before.gathered};
@@ -319,7 +334,7 @@ static int pilot_mark(const rs_scene *s, const rs_render_opts *base, int polariz
     f.wavelengths = 1;
     {
         double gc;
-        if (render_pixels(s, &f, px, &n, 1, c, &gc, NULL, spent, msg, msg_size) != 0)
+        if (render_pixels(s, &f, px, &n, 1, c, &gc, NULL, NULL, NULL, spent, msg, msg_size) != 0)
             goto out;
     }
     for (int pass = 0; pass < (polarized ? 1 : 2); pass++) {
@@ -440,9 +455,21 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
  * pixels it stands for). */
 typedef struct shot {
     rs_color *c;
+    double *pc;             /* each probe pixel's own cost */
+    unsigned char *split;   /* whether its spectral packet split (rs_worker_splits) */
     double cost;
     rs_work work[N_GROUPS]; /* what each group's render traced */
 } shot;
+
+static void shot_free(shot *s)
+{
+    free(s->c);
+    free(s->pc);
+    free(s->split);
+    s->c = NULL;
+    s->pc = NULL;
+    s->split = NULL;
+}
 
 static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set *ps, shot *out,
                  double *spent, char *msg, size_t msg_size)
@@ -450,12 +477,14 @@ static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set 
     double gc[N_GROUPS];
     size_t n = ps->n[G_MARKED] + ps->n[G_LENS] + ps->n[G_OTHER];
     out->c = malloc(sizeof *out->c * (n + 1));
-    if (!out->c) {
+    out->pc = malloc(sizeof *out->pc * (n + 1));
+    out->split = malloc(n + 1);
+    if (!out->c || !out->pc || !out->split) {
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
-    if (render_pixels(s, opts, ps->px, ps->n, N_GROUPS, out->c, gc, out->work, spent, msg,
-                      msg_size) != 0)
+    if (render_pixels(s, opts, ps->px, ps->n, N_GROUPS, out->c, gc, out->work, out->pc,
+                      out->split, spent, msg, msg_size) != 0)
         return -1;
     out->cost = 0.0;
     for (int g = 0; g < N_GROUPS; g++)
@@ -470,11 +499,15 @@ static int shot_copy(const probe_set *ps, const shot *from, shot *to, char *msg,
     size_t n = ps->n[G_MARKED] + ps->n[G_LENS] + ps->n[G_OTHER];
     *to = *from;
     to->c = malloc(sizeof *to->c * (n + 1));
-    if (!to->c) {
+    to->pc = malloc(sizeof *to->pc * (n + 1));
+    to->split = malloc(n + 1);
+    if (!to->c || !to->pc || !to->split) {
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
     memcpy(to->c, from->c, sizeof *to->c * n);
+    memcpy(to->pc, from->pc, sizeof *to->pc * n);
+    memcpy(to->split, from->split, n);
     return 0;
 }
 
@@ -588,6 +621,8 @@ typedef struct choice {
     rs_mode mode;
     int wavelengths, tree, rung; /* rung -1: rgb */
     double e, e_wl, e_tree, e_model, cost;
+    double tau;   /* the refinement's tolerance, 0: none */
+    double refined; /* the share of the image it renders again */
 } choice;
 
 static void consider(choice *best, int *n_cand, double E, choice c)
@@ -597,31 +632,92 @@ static void consider(choice *best, int *n_cand, double E, choice c)
         *best = c;
 }
 
+/* The refinement's tolerances tried, in E (rs_render_opts.refine_tol:
+ * a pixel's largest channel change on a doubling, where E is an RMS over
+ * the image, most of whose pixels never split). */
+static const double TAUS[] = {8.0, 4.0, 2.0, 1.0, 0.5, 0.25, 0.125};
+#define N_TAUS (sizeof TAUS / sizeof *TAUS)
+
+static double change_max(rs_color a, rs_color b)
+{
+    return fmax(fabs(a.r - b.r), fmax(fabs(a.g - b.g), fabs(a.b - b.b)));
+}
+
+/* The probe as the refinement renders it from rung k with tolerance tau
+ * (the integrator's rule, rs_integrator_pixel, replayed on the ladder's
+ * rungs up to the top, the refinement's last count): each pixel's value
+ * into sim, and the cost the renders again add over the image (each pixel
+ * standing for pw of its pixels) into *extra, the image's share they
+ * render into *share. */
+static void refine_replay(const probe_set *ps, const double *pw, const shot *rung, int n_rungs,
+                          int k, double tau, rs_color *sim, double *extra, double *share)
+{
+    size_t n = ps->n[G_MARKED] + ps->n[G_LENS] + ps->n[G_OTHER];
+    double total = 0.0;
+    *extra = 0.0;
+    *share = 0.0;
+    for (size_t p = 0; p < n; p++) {
+        rs_color v = rung[k].c[p];
+        total += pw[p];
+        if (rung[k].split[p] && k + 1 < n_rungs)
+            *share += pw[p];
+        for (int r = k + 1, calm = 0; r < n_rungs && rung[k].split[p]; r++) {
+            double change = change_max(rung[r].c[p], v);
+            *extra += pw[p] * rung[r].pc[p];
+            v = rung[r].c[p];
+            calm = change > tau || change != change ? 0 : calm + 1;
+            if (calm == 2)
+                break;
+        }
+        sim[p] = v;
+    }
+    *share = total > 0.0 ? *share / total : 0.0;
+}
+
 /* The cheapest candidate whose estimate is within E (cost < 0: none),
  * from the measurements so far (see auto_settings.h); *n_cand counts
- * the candidates. */
-static choice choose(const probe_set *ps, double E, int pol_only, rs_mode L, const tree *tr,
-                     int n_trees, int t_lad, const shot *rung, const int *rung_n, int n_rungs,
-                     double e_top, const double *e_model, const double *mcost, const shot *rgb,
-                     int *n_cand)
+ * the candidates.  sim: room for the probe's pixels. */
+static choice choose(const probe_set *ps, const double *pw, double E, int pol_only, rs_mode L,
+                     const tree *tr, int n_trees, int t_lad, const shot *rung, const int *rung_n,
+                     int n_rungs, double e_top, const double *e_model, const double *mcost,
+                     const shot *rgb, rs_color *sim, int *n_cand)
 {
     static const rs_mode spectral[3] = {RS_MODE_FRESNEL, RS_MODE_SCHLICK, RS_MODE_POLARIZED};
-    choice best = {RS_MODE_POLARIZED, 0, 0, 0, INFINITY, 0, 0, 0, -1.0};
+    choice best = {RS_MODE_POLARIZED, 0, 0, 0, INFINITY, 0, 0, 0, -1.0, 0.0, 0.0};
     const shot *top = &rung[n_rungs - 1];
     /* a single rung has no estimate of its own error */
     double e_t = n_rungs > 1 ? e_top : INFINITY;
     *n_cand = 0;
     for (int k = 0; k < n_rungs; k++) {
-        double e_wl = (k == n_rungs - 1 ? 0.0 : rms_diff(ps, rung[k].c, top->c)) + e_t;
-        for (int t = 0; t < n_trees; t++) {
-            double tcost = tr[t].s.cost / tr[t_lad].s.cost;
-            for (int m = 0; m < 3; m++) {
-                if (pol_only && spectral[m] != RS_MODE_POLARIZED)
+        /* without refinement (ti == -1), then with each tolerance */
+        for (int ti = -1; ti < (k + 1 < n_rungs ? (int)N_TAUS : 0); ti++) {
+            double tau = ti < 0 ? 0.0 : TAUS[ti] * E, extra = 0.0, share = 0.0, e_wl;
+            if (ti < 0) {
+                e_wl = (k == n_rungs - 1 ? 0.0 : rms_diff(ps, rung[k].c, top->c)) + e_t;
+            } else {
+                refine_replay(ps, pw, rung, n_rungs, k, tau, sim, &extra, &share);
+                if (share <= 0.0)
+                    break; /* no pixel split: nothing to refine */
+                /* A refined pixel is left within about tau of its
+                 * converged value (or at the top's count): over the image
+                 * that is at most tau sqrt(share) whatever the probe saw
+                 * -- its few split pixels can miss the rare ones a coarse
+                 * grid gets most wrong, which a looser tau leaves so. */
+                if (tau * sqrt(share) > E)
                     continue;
-                choice c = {spectral[m], rung_n[k], t, k, 0, e_wl, tr[t].e, e_model[spectral[m]], 0};
-                c.e = hypot(c.e_wl, c.e_model) + c.e_tree;
-                c.cost = rung[k].cost * tcost * mcost[spectral[m]];
-                consider(&best, n_cand, E, c);
+                e_wl = rms_diff(ps, sim, top->c) + e_t;
+            }
+            for (int t = 0; t < n_trees; t++) {
+                double tcost = tr[t].s.cost / tr[t_lad].s.cost;
+                for (int m = 0; m < 3; m++) {
+                    if (pol_only && spectral[m] != RS_MODE_POLARIZED)
+                        continue;
+                    choice c = {spectral[m], rung_n[k], t, k, 0, e_wl, tr[t].e,
+                                e_model[spectral[m]], 0, tau, share};
+                    c.e = hypot(c.e_wl, c.e_model) + c.e_tree;
+                    c.cost = (rung[k].cost + extra) * tcost * mcost[spectral[m]];
+                    consider(&best, n_cand, E, c);
+                }
             }
         }
     }
@@ -629,7 +725,7 @@ static choice choose(const probe_set *ps, double E, int pol_only, rs_mode L, con
         for (int t = 0; t < n_trees; t++) {
             if (!rgb[t].c)
                 continue;
-            choice c = {RS_MODE_RGB, 0, t, -1, 0, 0, 0, 0, rgb[t].cost};
+            choice c = {RS_MODE_RGB, 0, t, -1, 0, 0, 0, 0, rgb[t].cost, 0.0, 0.0};
             c.e = hypot(rms_diff(ps, rgb[t].c, top->c) + e_t, e_model[L]) + tr[t_lad].e;
             c.e_model = c.e;
             consider(&best, n_cand, E, c);
@@ -654,7 +750,9 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     double rung_spent = 0.0;
     int depths[4], n_depths = 0, depth_max;
     rs_render_opts o;
-    choice best = {RS_MODE_POLARIZED, 0, 0, 0, INFINITY, 0, 0, 0, -1.0};
+    choice best = {RS_MODE_POLARIZED, 0, 0, 0, INFINITY, 0, 0, 0, -1.0, 0.0, 0.0};
+    double *pw = NULL;    /* per probe pixel: the image's pixels it stands for */
+    rs_color *sim = NULL; /* the probe as a refinement renders it */
 
     memset(tr, 0, sizeof tr);
     memset(rung, 0, sizeof rung);
@@ -709,6 +807,18 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         pilot.cutoff = req->cutoff >= 0.0 ? req->cutoff : CUTOFFS[0];
         if (probe_pick(scene, &pilot, pol_reason != NULL, &ps, &spent, msg, msg_size) != 0)
             return -1;
+    }
+    {
+        size_t n = ps.n[G_MARKED] + ps.n[G_LENS] + ps.n[G_OTHER], k = 0;
+        pw = malloc(sizeof *pw * (n + 1));
+        sim = malloc(sizeof *sim * (n + 1));
+        if (!pw || !sim) {
+            snprintf(msg, msg_size, "out of memory");
+            goto done;
+        }
+        for (int g = 0; g < N_GROUPS; g++)
+            for (size_t m = 0; m < ps.n[g]; m++)
+                pw[k++] = ps.pop[g] / (double)ps.n[g];
     }
 
     /* Every tree, in rgb (cheap, and each an rgb candidate) or, where the
@@ -765,8 +875,8 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     n_rungs = 1;
     for (;;) {
         double before = spent;
-        best = choose(&ps, E, pol_reason != NULL, L, tr, n_trees, t_lad, rung, rung_n, n_rungs,
-                      e_top, e_model, mcost, rgb, &n_cand);
+        best = choose(&ps, pw, E, pol_reason != NULL, L, tr, n_trees, t_lad, rung, rung_n,
+                      n_rungs, e_top, e_model, mcost, rgb, sim, &n_cand);
         if (req->wavelengths > 0 || rung_n[n_rungs - 1] >= WAVELENGTHS_MAX ||
             n_rungs == RUNGS_MAX || (n_rungs > 1 && e_top <= TOP_SHARE * E) ||
             (best.cost >= 0.0 && 2.0 * rung_spent > CLIMB_SHARE * best.cost))
@@ -785,7 +895,7 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     if (best.cost < 0.0) {
         /* nothing meets E: the most accurate there is */
         best = (choice){RS_MODE_POLARIZED, rung_n[n_rungs - 1], t_star, n_rungs - 1, 0, e_top,
-                        tr[t_star].e, 0, 0};
+                        tr[t_star].e, 0, 0, 0.0, 0.0};
         best.e = best.e_wl + best.e_tree;
         best.cost = rung[n_rungs - 1].cost * tr[t_star].s.cost / tr[t_lad].s.cost *
                     mcost[RS_MODE_POLARIZED];
@@ -796,7 +906,15 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     o.wavelengths = best.mode == RS_MODE_RGB ? o.wavelengths : best.wavelengths;
     o.depth = tr[best.tree].depth;
     o.cutoff = tr[best.tree].cutoff;
+    o.refine_tol = best.tau;
+    o.refine_max = best.tau > 0.0 ? rung_n[n_rungs - 1] : 0;
     {
+        char refine[160] = "";
+        if (best.tau > 0.0)
+            snprintf(refine, sizeof refine,
+                     ", refined up to %d where a doubling changes a pixel by more than %.2g "
+                     "(%.0f %% of the image split at a lens)",
+                     o.refine_max, best.tau, 100.0 * best.refined);
         char model[160], lens[160], parts[160];
         size_t n = ps.n[G_MARKED] + ps.n[G_LENS] + ps.n[G_OTHER];
         if (pol_reason)
@@ -822,11 +940,11 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
                      100.0 * spent / best.cost);
         else
             snprintf(why, why_size,
-                     "%s, %d wavelengths%s, depth %d, cut-off %.3g for E = %.3g: estimated error "
+                     "%s, %d wavelengths%s%s, depth %d, cut-off %.3g for E = %.3g: estimated error "
                      "%.2g (%s)%s, the cheapest of %d candidates; %s; %s; probe %zu pixels, %.0f %% "
                      "of the render's cost",
                      rs_mode_name(o.mode), o.wavelengths, req->wavelengths > 0 ? " (yours)" : "",
-                     o.depth, o.cutoff, E, best.e, parts,
+                     refine, o.depth, o.cutoff, E, best.e, parts,
                      over ? ", over E: no candidate meets it" : "", n_cand, model, lens, n,
                      100.0 * spent / best.cost);
     }
@@ -838,12 +956,13 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     rc = 0;
 done:
     free(ps.px);
-    for (int t = 0; t < n_trees; t++) {
-        free(tr[t].s.c);
-    }
+    free(pw);
+    free(sim);
+    for (int t = 0; t < n_trees; t++)
+        shot_free(&tr[t].s);
     for (int k = 0; k < RUNGS_MAX; k++)
-        free(rung[k].c);
-    free(pol.c);
-    free(sch.c);
+        shot_free(&rung[k]);
+    shot_free(&pol);
+    shot_free(&sch);
     return rc;
 }

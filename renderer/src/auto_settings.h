@@ -64,6 +64,25 @@
  *               plus the top's own error, in quadrature with the top's
  *               model part, plus the top's tree part.
  *
+ * Per pixel, where it helps: a candidate may refine its wavelengths
+ * (rs_render_opts.refine_tol): a pixel whose spectral packet split at a
+ * dispersive lens is rendered again at 2N, 4N ... until two doublings in
+ * a row change no channel by more than tau, or at the ladder's top count
+ * (refine_max); the rest keep N.  Each rung N is tried with tau = E / 8
+ * ... 8 E, each replayed on the probe's rungs (the probe's own split
+ * pixels stepping up them by the same rule): its e_wl is the replayed
+ * probe's difference from the top plus the top's error, its cost the
+ * rung's plus what the replayed renders again cost.  tau sqrt(s) <= E
+ * (s the share of the image that split): a pixel is left within about
+ * tau of its converged value, which bounds what the refined pixels add
+ * whatever the probe saw -- a looser tau let the few pixels a coarse grid
+ * gets most wrong, which the probe's ~100 pixels miss, through (at
+ * 8 E: default.scene 1.08e-4 and meniscus 1.01e-4 against E = 1e-4).
+ * Two doublings, not one: a band of wavelengths that a lens sends
+ * elsewhere, narrower than two grids' spacing, can leave them equal
+ * (default.scene at 128 x 96: two pixels 4e-4 apart at 4 and 8
+ * wavelengths, 0.4 at 16).
+ *
  * Costs are deterministic: every probe render counts its work
  * (rs_worker_work) and prices it (rs_work_cost); a candidate's cost is
  * predicted from the ladder's rung, scaled by its tree's and its model's

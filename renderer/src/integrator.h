@@ -32,6 +32,16 @@ typedef struct rs_render_opts {
     int width, height;
     int aa;            /* N x N regular samples per pixel at the centres
                           of an N x N grid, averaged (default 1) */
+    /* Refinement of the wavelengths per pixel (spectral modes; auto sets
+     * it): a pixel whose spectral packet split at a dispersive lens (its
+     * lanes went different ways: its spectrum may have steps, whose error
+     * falls only as 1/N) is rendered again at twice the wavelengths, and
+     * again, until two doublings in a row change no channel by more than
+     * refine_tol, or at refine_max wavelengths; it takes the last
+     * render's value, bit for bit what a render at that count gives it.
+     * refine_tol <= 0 (default): off. */
+    double refine_tol;
+    int refine_max;
 } rs_render_opts;
 
 void rs_render_opts_init(rs_render_opts *o);
@@ -67,6 +77,12 @@ typedef struct rs_work {
 } rs_work;
 
 void rs_worker_work(const rs_worker *w, rs_work *out);
+
+/* How many lens hits of the worker's so far split a spectral packet
+ * (lanes of different optics there: a dispersive lens).  A pixel whose
+ * render leaves it unchanged has a spectrum without the steps that lanes
+ * going different ways make.  The refinement's own renders not counted. */
+unsigned long long rs_worker_splits(const rs_worker *w);
 
 /* The cost of work w done on `pixels` pixels in a mode, in instructions
  * of this renderer: per mode a linear fit (non-negative least squares of

@@ -21,7 +21,7 @@
 
 #define TILE_SIZE 16
 #define MSG_MAX 1024
-#define WHY_MAX 512
+#define WHY_MAX 1024
 
 struct lr_scene {
     rs_scene s;

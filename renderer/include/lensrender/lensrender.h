@@ -199,7 +199,11 @@ typedef enum lr_mode {
     LR_MODE_RGB = 3,       /* three colour channels, unpolarized */
     LR_MODE_AUTO = 4       /* the model, wavelengths, depth and cut-off that
                               keep the error within the tolerance at the
-                              least cost, chosen by lr_renderer_create */
+                              least cost, chosen by lr_renderer_create;
+                              and, where it costs less, more wavelengths
+                              for the pixels whose spectrum a dispersive
+                              lens makes step (each pixel still what a
+                              render at its own count gives it) */
 } lr_mode;
 
 /* The option name of a mode: "polarized", "fresnel", "schlick", "rgb",
@@ -264,7 +268,9 @@ void lr_renderer_free(lr_renderer *renderer);
 
 /* The options the renderer renders with: those given, with auto's
  * choice of mode (never LR_MODE_AUTO), wavelengths, depth and cut-off,
- * and the scene's depth and cut-off where 0 and < 0 asked for them. */
+ * and the scene's depth and cut-off where 0 and < 0 asked for them.
+ * Where auto refines pixels (its explanation says so), wavelengths is
+ * the count every pixel starts with. */
 void lr_renderer_settings(const lr_renderer *renderer, lr_render_opts *out);
 
 /* For LR_MODE_AUTO, one line (no newline) saying what was chosen and
