@@ -36,6 +36,18 @@ static const char *scene_text =
     "lens { radius1 40 radius2 -40 thickness 6 diameter 20 glass \"N-BK7\"\n"
     "       rotate <-90, 0, 0> translate <-4, 16, -18> }\n";
 
+/* A lens over a self-lit black-and-white checker, which it disperses into
+ * coloured edges: auto refines the pixels seen through it. */
+static const char *dispersed_text =
+    "global_settings { max_trace_level 8 adc_bailout 0.002 }\n"
+    "camera { location <0, 95, -55> look_at <0, 14, 0>\n"
+    "         right x*image_width/image_height angle 36 }\n"
+    "background { rgb <0.20, 0.30, 0.50> }\n"
+    "lens { radius1 50 radius2 -50 thickness 8 diameter 25 glass \"N-BK7\"\n"
+    "       rotate <-90, 0, 0> translate <0, 20, 0> }\n"
+    "plane { y, 0 pigment { checker rgb 0.9, rgb 0.1 scale 5 }\n"
+    "        finish { ambient 0 diffuse 0 emission 1 } }\n";
+
 /* "sphere" at line 3, column 1, lacks its '{'. */
 static const char *bad_text =
     "camera { location <0, 0, -5> }\n"
@@ -260,6 +272,66 @@ int main(void)
                   "pixel byte for byte", threads);
         }
         lr_renderer_free(rt);
+    }
+    {
+        /* auto, where it refines pixels (more wavelengths for the pixels
+         * the lens disperses): the image still the same whatever the
+         * regions, the threads and the order */
+        static float aref[3 * W * H], aimg[3 * W * H];
+        static int xy[2 * W * H];
+        static float got[3 * W * H];
+        static const double tols[] = {1e-2, 1e-3};
+        int refined = 0;
+        lr_scene *ds = NULL;
+        lr_load_opts lo;
+        lr_load_opts_init(&lo);
+        lo.image_width = W;
+        lo.image_height = H;
+        CHECK(lr_scene_load_string(dispersed_text, "dispersed.scene", &lo, &ds, &err) == LR_OK,
+              "the dispersed scene loads: %s", err.message);
+        for (size_t t = 0; ds && t < sizeof tols / sizeof *tols; t++) {
+            lr_renderer *ra = NULL, *rb = NULL;
+            lr_render_opts ao;
+            lr_render_opts_init(&ao);
+            ao.mode = LR_MODE_AUTO;
+            ao.tolerance = tols[t];
+            ao.width = W;
+            ao.height = H;
+            ao.threads = 1;
+            CHECK(lr_renderer_create(ds, &ao, &ra, &err) == LR_OK, "auto: %s", err.message);
+            ao.threads = 3;
+            CHECK(lr_renderer_create(ds, &ao, &rb, &err) == LR_OK, "auto: %s", err.message);
+            if (!ra || !rb) {
+                lr_renderer_free(ra);
+                lr_renderer_free(rb);
+                continue;
+            }
+            refined += strstr(lr_renderer_explanation(ra), "refined") != NULL;
+            CHECK(strcmp(lr_renderer_explanation(ra), lr_renderer_explanation(rb)) == 0,
+                  "auto chooses the same whatever the threads");
+            CHECK(lr_render_image(ra, aref, NULL, NULL, &err) == LR_OK &&
+                      lr_render_image(rb, aimg, NULL, NULL, &err) == LR_OK &&
+                      memcmp(aimg, aref, sizeof aimg) == 0,
+                  "auto at E = %g: 3 threads give the 1-thread image", tols[t]);
+            memset(aimg, 0xff, sizeof aimg);
+            CHECK(render_by_regions(rb, 3, 4, aimg) == 0 && memcmp(aimg, aref, sizeof aimg) == 0,
+                  "auto at E = %g: 3 x 4 regions give the image byte for byte", tols[t]);
+            for (int k = 0; k < W * H; k++) {
+                int m = (int)(((long)k * 29 + 11) % (W * H));
+                xy[2 * k] = m % W;
+                xy[2 * k + 1] = m / W;
+            }
+            int same = lr_render_pixels(rb, xy, (size_t)W * H, got, NULL, NULL, &err) == LR_OK;
+            for (int k = 0; same && k < W * H; k++)
+                same = memcmp(&got[3 * k], &aref[3 * (xy[2 * k + 1] * W + xy[2 * k])],
+                              3 * sizeof(float)) == 0;
+            CHECK(same, "auto at E = %g: a scrambled list gives each pixel byte for byte",
+                  tols[t]);
+            lr_renderer_free(ra);
+            lr_renderer_free(rb);
+        }
+        CHECK(refined > 0, "auto refines pixels at one of the tolerances at least");
+        lr_scene_free(ds);
     }
     {
         float one[3];
