@@ -30,8 +30,7 @@
 #include "auto_settings.h"
 #include "check.h"
 #include "integrator.h"
-#include "library_path.h"
-#include "parser.h"
+#include "load_scene.h"
 #include "scene.h"
 
 #define W 12
@@ -45,24 +44,6 @@
 #define UNRESOLVED_1E3 \
     "biconcave", "conical_rim", "meniscus", "dispersion", "polariscope", "michel_levy", "conoscope"
 #define REF_CUTOFF 1e-7 /* a dropped branch carries < 1e-7: far below every E */
-
-static int load(rs_scene *sc, const char *path)
-{
-    char msg[1024] = "";
-    rs_parse_opts po;
-    const char *dirs[4];
-    rs_parse_opts_init(&po);
-    po.image_width = W;
-    po.image_height = H;
-    po.include_dirs = dirs; /* colors.inc and lens.inc, as lensrender finds them */
-    po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof *dirs);
-    if (rs_parse_file(path, &po, sc, msg, sizeof msg) != 0 ||
-        rs_scene_prepare(sc, msg, sizeof msg) != 0) {
-        fprintf(stderr, "%s: %s\n", path, msg);
-        return -1;
-    }
-    return 0;
-}
 
 /* Render o's image into out (NULL: not kept); *cost (when not NULL) gets
  * the render's cost in rs_work_cost's units, counted, not timed. */
@@ -267,7 +248,7 @@ static void one_scene(const shipped_scene *ss)
 
     snprintf(path, sizeof path, "%s/scenes/%s", LP_SOURCE_DIR, ss->file);
     rs_scene_init(&sc);
-    if (load(&sc, path) != 0) {
+    if (load_scene(&sc, path, NULL, NULL, W, H) != 0) {
         CHECK(0, "%s: loads", name);
         rs_scene_free(&sc);
         return;
@@ -346,18 +327,13 @@ static void plain_scene(void)
         "light_source { <10, 20, -10> color rgb 1 }\n"
         "plane { y, 0 pigment { checker rgb 1, rgb 0.2 } }\n"
         "sphere { <0, 1, 0>, 1 pigment { color rgb <1, 0.5, 0.2> } }\n";
-    char msg[512], why[512];
-    rs_parse_opts po;
+    char msg[512], why[1024];
     rs_scene sc;
     rs_render_opts ch;
     rs_auto_request req = {1e-2, W, H, 0, 0, -1.0};
     rs_scene_init(&sc);
-    rs_parse_opts_init(&po);
-    po.image_width = W;
-    po.image_height = H;
-    if (rs_parse_string(text, "<plain>", &po, &sc, msg, sizeof msg) != 0 ||
-        rs_scene_prepare(&sc, msg, sizeof msg) != 0) {
-        CHECK(0, "plain scene: %s", msg);
+    if (load_scene(&sc, NULL, text, "<plain>", W, H) != 0) {
+        CHECK(0, "plain scene loads");
         rs_scene_free(&sc);
         return;
     }

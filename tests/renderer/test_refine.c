@@ -20,8 +20,7 @@
 
 #include "check.h"
 #include "integrator.h"
-#include "library_path.h"
-#include "parser.h"
+#include "load_scene.h"
 #include "scene.h"
 
 #define W 32
@@ -29,25 +28,6 @@
 #define N0 4
 #define N_MAX 64
 #define LEVELS 5 /* 4, 8, 16, 32, 64 */
-
-static int load(rs_scene *sc, const char *path, const char *text)
-{
-    char msg[1024] = "";
-    rs_parse_opts po;
-    const char *dirs[4];
-    rs_parse_opts_init(&po);
-    po.image_width = W;
-    po.image_height = H;
-    po.include_dirs = dirs;
-    po.n_include_dirs = rs_library_path(NULL, 0, dirs, sizeof dirs / sizeof *dirs);
-    if ((path ? rs_parse_file(path, &po, sc, msg, sizeof msg)
-              : rs_parse_string(text, "refine.scene", &po, sc, msg, sizeof msg)) != 0 ||
-        rs_scene_prepare(sc, msg, sizeof msg) != 0) {
-        fprintf(stderr, "%s: %s\n", path ? path : "refine.scene", msg);
-        return -1;
-    }
-    return 0;
-}
 
 static int same(rs_color a, rs_color b)
 {
@@ -154,7 +134,7 @@ static void dispersive_scene(void)
     int counts[LEVELS];
     snprintf(path, sizeof path, "%s/scenes/default.scene", LP_SOURCE_DIR);
     rs_scene_init(&sc);
-    CHECK(load(&sc, path, NULL) == 0, "default.scene loads");
+    CHECK(load_scene(&sc, path, NULL, NULL, W, H) == 0, "default.scene loads");
     for (int m = 0; m < 2; m++) {
         rs_mode mode = m ? RS_MODE_POLARIZED : RS_MODE_FRESNEL;
         int n_split = against_replay(&sc, mode, 1e-3, counts);
@@ -187,7 +167,7 @@ static void clear_scene(void)
     rs_scene sc;
     int counts[LEVELS];
     rs_scene_init(&sc);
-    CHECK(load(&sc, NULL, text) == 0, "the clear scene loads");
+    CHECK(load_scene(&sc, NULL, text, "clear.scene", W, H) == 0, "the clear scene loads");
     CHECK(against_replay(&sc, RS_MODE_FRESNEL, 1e-3, counts) == 0,
           "a lens without dispersion splits no packet");
     CHECK(counts[0] == W * H, "every pixel is the plain render's");
