@@ -212,7 +212,9 @@ struct rs_worker {
     unsigned char *cc_half_has; /* the same */
     rs_work work;         /* what this worker has traced (rs_worker_work) */
     unsigned long long lane_splits; /* rs_worker_splits */
-    rs_worker *finer;     /* it->finer's, made when first needed */
+    rs_worker *finer;     /* the next count's, made when first needed */
+    rs_integrator *own_finer; /* the next count past the integrator's own
+                             counts (refine_outlier), this worker's */
     int finer_failed;     /* it could not be made: no refinement */
 };
 
@@ -231,6 +233,8 @@ void rs_render_opts_init(rs_render_opts *o)
     o->aa = 1;
     o->refine_tol = 0.0;
     o->refine_max = 0;
+    o->refine_outlier = 0.0;
+    o->refine_limit = 0;
 }
 
 /* The linear sRGB colour of a light's spectrum (negative components of
@@ -422,6 +426,9 @@ int rs_integrator_create(const rs_scene *scene, const rs_render_opts *opts, rs_i
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
+    /* The refinement's counts up to refine_max, which most refined
+     * pixels reach; past it only a few (refine_outlier), whose worker
+     * makes the counts it needs (finer_worker). */
     if (it->opts.refine_tol > 0.0 && it->opts.mode != RS_MODE_RGB &&
         it->opts.wavelengths <= it->opts.refine_max / 2) {
         rs_render_opts f = it->opts;
@@ -539,6 +546,7 @@ void rs_worker_destroy(rs_worker *w)
     if (!w)
         return;
     rs_worker_destroy(w->finer);
+    rs_integrator_destroy(w->own_finer);
     for (int f = 0; f < RS_MAX_FRAMES; f++)
         frame_free(w->frames[f]);
     free(w->lane_all);
@@ -2300,12 +2308,33 @@ static void pixel_at(const rs_integrator *it, rs_worker *w, int i, int j, rs_col
     *out = (rs_color){sum.r / (n * aa * aa), sum.g / (n * aa * aa), sum.b / (n * aa * aa)};
 }
 
-/* The worker of it->finer beside w, made when first needed (NULL when it
- * cannot be: the pixel then keeps the value it has). */
+/* Is there a count past it's for the refinement: its own next, or past
+ * refine_max, while a pixel changes by more than refine_outlier, up to
+ * refine_limit? */
+static int has_finer(const rs_integrator *it)
+{
+    return it->finer || (it->opts.refine_outlier > 0.0 &&
+                         it->opts.wavelengths >= it->opts.refine_max &&
+                         it->opts.wavelengths <= it->opts.refine_limit / 2);
+}
+
+/* The worker of the next count beside w, made when first needed: of
+ * w->it->finer, or past the integrator's own counts of an integrator of
+ * the worker's own (the same options at twice the wavelengths: the same
+ * values whoever makes it).  NULL when it cannot be made: the pixel then
+ * keeps the value it has. */
 static rs_worker *finer_worker(rs_worker *w)
 {
     if (!w->finer && !w->finer_failed) {
-        w->finer = rs_worker_create(w->it->finer);
+        const rs_integrator *next = w->it->finer;
+        if (!next) {
+            char msg[256];
+            rs_render_opts f = w->it->opts;
+            f.wavelengths *= 2;
+            if (rs_integrator_create(w->it->scene, &f, &w->own_finer, msg, sizeof msg) == 0)
+                next = w->own_finer;
+        }
+        w->finer = next ? rs_worker_create(next) : NULL;
         w->finer_failed = !w->finer;
     }
     return w->finer;
@@ -2315,7 +2344,7 @@ void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs
 {
     unsigned long long before = w->lane_splits;
     pixel_at(it, w, i, j, out);
-    if (!it->finer || w->lane_splits == before)
+    if (!has_finer(it) || w->lane_splits == before)
         return;
     /* The refinement (rs_render_opts.refine_tol): twice the wavelengths
      * until two doublings in a row change no channel by more than the
@@ -2329,13 +2358,22 @@ void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs
         rs_color c;
         if (!fw)
             return;
-        pixel_at(it->finer, fw, i, j, &c);
+        const rs_integrator *fi = fw->it;
+        pixel_at(fi, fw, i, j, &c);
         double change = fmax(fabs(c.r - out->r), fmax(fabs(c.g - out->g), fabs(c.b - out->b)));
         *out = c;
         calm = change > it->opts.refine_tol || change != change ? 0 : calm + 1;
-        if (calm == 2 || !it->finer->finer)
+        if (!has_finer(fi))
             return;
-        it = it->finer;
+        if (fi->opts.wavelengths >= it->opts.refine_max) {
+            /* past the top, only a pixel that still changes by more than
+             * refine_outlier */
+            if (!(change > it->opts.refine_outlier))
+                return;
+        } else if (calm == 2) {
+            return;
+        }
+        it = fi;
         w = fw;
     }
 }

@@ -39,9 +39,16 @@ typedef struct rs_render_opts {
      * again, until two doublings in a row change no channel by more than
      * refine_tol, or at refine_max wavelengths; it takes the last
      * render's value, bit for bit what a render at that count gives it.
-     * refine_tol <= 0 (default): off. */
+     * refine_tol <= 0 (default): off.  Past refine_max a pixel whose
+     * last doubling still changed some channel by more than
+     * refine_outlier (> 0) goes on doubling, up to refine_limit: a pixel
+     * that alone would take a noticeable share of the image's error (a
+     * bright light seen through a dispersive lens: a step of its size in
+     * the spectrum). */
     double refine_tol;
     int refine_max;
+    double refine_outlier;
+    int refine_limit;
 } rs_render_opts;
 
 void rs_render_opts_init(rs_render_opts *o);

@@ -4,8 +4,10 @@
  * The rule, restated here and replayed on integrators without it: a
  * pixel whose render at N wavelengths split a spectral packet at a lens
  * (rs_worker_splits) is rendered at 2N, 4N ... until two doublings in a
- * row change no channel by more than the tolerance, or at refine_max; it
- * takes its last render's value.  So every pixel of a refining render
+ * row change no channel by more than the tolerance, or at refine_max --
+ * past which it goes on doubling, up to refine_limit, while its last
+ * doubling changed some channel by more than refine_outlier; it takes its
+ * last render's value.  So every pixel of a refining render
  * must equal, bit for bit, the plain render at the count the replay ends
  * on, and its work must be the sum of the replay's renders' work.  A
  * scene whose lens does not disperse (and one without lenses) splits no
@@ -26,8 +28,9 @@
 #define W 32
 #define H 24
 #define N0 4
-#define N_MAX 64
-#define LEVELS 5 /* 4, 8, 16, 32, 64 */
+#define N_MAX 64   /* refine_max */
+#define N_LIMIT 256 /* refine_limit */
+#define LEVELS 7    /* 4, 8 ... 256 */
 
 static int same(rs_color a, rs_color b)
 {
@@ -41,7 +44,8 @@ static double change_max(rs_color a, rs_color b)
 
 /* A refining render of sc in mode against the replay; counts[l] gets the
  * pixels that ended at level l.  Returns the pixels that split. */
-static int against_replay(const rs_scene *sc, rs_mode mode, double tol, int *counts)
+static int against_replay(const rs_scene *sc, rs_mode mode, double tol, double outlier,
+                          int *counts)
 {
     char msg[512];
     rs_integrator *plain[LEVELS], *ref;
@@ -65,6 +69,8 @@ static int against_replay(const rs_scene *sc, rs_mode mode, double tol, int *cou
     o.wavelengths = N0;
     o.refine_tol = tol;
     o.refine_max = N_MAX;
+    o.refine_outlier = outlier;
+    o.refine_limit = N_LIMIT;
     CHECK(rs_integrator_create(sc, &o, &ref, msg, sizeof msg) == 0, "refining: %s", msg);
     rw = rs_worker_create(ref);
     CHECK(rw != NULL, "worker");
@@ -97,7 +103,7 @@ static int against_replay(const rs_scene *sc, rs_mode mode, double tol, int *cou
                 want = c;
                 level = l;
                 calm = ch > tol ? 0 : calm + 1;
-                if (calm == 2)
+                if ((N0 << l) >= N_MAX ? !(ch > outlier) : calm == 2)
                     break;
             }
             counts[level]++;
@@ -137,18 +143,21 @@ static void dispersive_scene(void)
     CHECK(load_scene(&sc, path, NULL, NULL, W, H) == 0, "default.scene loads");
     for (int m = 0; m < 2; m++) {
         rs_mode mode = m ? RS_MODE_POLARIZED : RS_MODE_FRESNEL;
-        int n_split = against_replay(&sc, mode, 1e-3, counts);
-        printf("%s: %d of %d pixels split; ended at 4..64 wavelengths: %d %d %d %d %d\n",
+        int n_split = against_replay(&sc, mode, 1e-3, 0.003, counts);
+        printf("%s: %d of %d pixels split; ended at 4..256 wavelengths: %d %d %d %d %d %d %d\n",
                m ? "polarized" : "fresnel", n_split, W * H, counts[0], counts[1], counts[2],
-               counts[3], counts[4]);
+               counts[3], counts[4], counts[5], counts[6]);
         /* the test means something only if every way a pixel can end is
-         * taken: unsplit, calm after two doublings, calm later, at the top */
+         * taken: unsplit, calm after two doublings, calm later, at the top,
+         * past the top */
         CHECK(n_split > 0 && n_split < W * H / 2, "some pixels split, most not (%d)", n_split);
         CHECK(counts[0] == W * H - n_split, "the unsplit pixels end at the first count");
         CHECK(counts[1] == 0, "no pixel ends after one doubling");
         CHECK(counts[2] > 0 && counts[3] > 0 && counts[4] > 0,
               "pixels end at 16, 32 and 64 wavelengths (%d %d %d)", counts[2], counts[3],
               counts[4]);
+        CHECK(counts[5] + counts[6] > 0, "pixels go on past the top (%d %d)", counts[5],
+              counts[6]);
     }
     rs_scene_free(&sc);
 }
@@ -168,7 +177,7 @@ static void clear_scene(void)
     int counts[LEVELS];
     rs_scene_init(&sc);
     CHECK(load_scene(&sc, NULL, text, "clear.scene", W, H) == 0, "the clear scene loads");
-    CHECK(against_replay(&sc, RS_MODE_FRESNEL, 1e-3, counts) == 0,
+    CHECK(against_replay(&sc, RS_MODE_FRESNEL, 1e-3, 0.003, counts) == 0,
           "a lens without dispersion splits no packet");
     CHECK(counts[0] == W * H, "every pixel is the plain render's");
     rs_scene_free(&sc);
