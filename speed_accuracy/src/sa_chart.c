@@ -427,18 +427,21 @@ static int write_md(const sa_points *ps, const char **names, size_t ns, const ch
           "between (the reference cannot tell); the cheapest swept setting that meets\n"
           "E the same way (error + U ≤ E; none when U ≥ E: E is below what the\n"
           "reference resolves); auto's time over that one's (the goal is ≤ 1.25) and\n"
-          "over the default polarized render's.\n\n"
+          "over the default polarized render's; and whether auto sits on the front\n"
+          "at its own error: its time over that of the cheapest swept setting at\n"
+          "least as accurate (errors under U counted as U), *beyond* where no swept\n"
+          "setting is (auto refines pixels the uniform grid cannot).\n\n"
           "| scene | E | auto's choice | auto rmse | meets E | auto s | cheapest swept meeting E "
-          "| its rmse | its s | auto / cheapest | auto / default |\n"
-          "|---|---|---|---|---|---|---|---|---|---|---|\n", f);
+          "| its rmse | its s | auto / cheapest | auto / default | auto / front at its error |\n"
+          "|---|---|---|---|---|---|---|---|---|---|---|---|\n", f);
     for (size_t k = 0; k < ns; k++) {
         const sa_point *dflt = find(ps, names[k], "default", 0.0);
         const sa_point *sw[1024];
         size_t n = swept(ps, names[k], sw, 1024);
         double u = uncertainty(ps, names[k]);
         for (int t = 0; t < 3; t++) {
-            const sa_point *a = find(ps, names[k], "auto", TOLS[t]), *best = NULL;
-            char s1[160] = "—";
+            const sa_point *a = find(ps, names[k], "auto", TOLS[t]), *best = NULL, *at = NULL;
+            char s1[160] = "—", s2[64] = "—";
             const char *verdict = "—";
             for (size_t i = 0; i < n && !best; i++)
                 if (meets(sw[i]->err.rmse, u, TOLS[t]))
@@ -447,15 +450,23 @@ static int write_md(const sa_points *ps, const char **names, size_t ns, const ch
                 setting(s1, sizeof s1, best);
             else if (!(u < TOLS[t]))
                 snprintf(s1, sizeof s1, "none: E ≤ U = %.2g", u);
+            for (size_t i = 0; a && i < n && !at; i++)
+                if (fmax(sw[i]->err.rmse, u) <= fmax(a->err.rmse, u))
+                    at = sw[i];
+            if (a && at)
+                snprintf(s2, sizeof s2, "%.2f", a->seconds / at->seconds);
+            else if (a && a->err.rmse == a->err.rmse)
+                snprintf(s2, sizeof s2, "beyond");
             if (a)
                 verdict = meets(a->err.rmse, u, TOLS[t])     ? "yes"
                           : a->err.rmse - u > TOLS[t]        ? "**no**"
                                                              : "unresolved";
-            fprintf(f, "| %s | %g | %s | %.2g | %s | %.3g | %s | %.2g | %.3g | %.2f | %.2f |\n",
+            fprintf(f,
+                    "| %s | %g | %s | %.2g | %s | %.3g | %s | %.2g | %.3g | %.2f | %.2f | %s |\n",
                     names[k], TOLS[t], a ? a->note : "—", a ? a->err.rmse : NAN, verdict,
                     a ? a->seconds : NAN, s1, best ? best->err.rmse : NAN,
                     best ? best->seconds : NAN, a && best ? a->seconds / best->seconds : NAN,
-                    a && dflt ? a->seconds / dflt->seconds : NAN);
+                    a && dflt ? a->seconds / dflt->seconds : NAN, s2);
         }
     }
     fputs("\n## The references and POV-Ray\n\n"
