@@ -2313,7 +2313,8 @@ static void pixel_at(const rs_integrator *it, rs_worker *w, int i, int j, rs_col
  * refine_limit? */
 static int has_finer(const rs_integrator *it)
 {
-    return it->finer || (it->opts.refine_outlier > 0.0 &&
+    return it->finer || (it->opts.refine_outlier > 0.0 && it->opts.refine_tol > 0.0 &&
+                         it->opts.mode != RS_MODE_RGB &&
                          it->opts.wavelengths >= it->opts.refine_max &&
                          it->opts.wavelengths <= it->opts.refine_limit / 2);
 }
