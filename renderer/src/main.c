@@ -53,8 +53,10 @@ static const char *const usage_text[] = {
 "                        rgb        three colour channels, unpolarized\n"
 "                        auto       the model, wavelengths, depth and\n"
 "                                   cut-off that keep the error within\n"
-"                                   --tolerance at the least cost (it says\n"
-"                                   what it chose and why)\n"
+"                                   --tolerance at the least cost, and\n"
+"                                   more wavelengths for the pixels whose\n"
+"                                   spectrum a dispersive lens makes step\n"
+"                                   (it says what it chose and why)\n"
 "  --tolerance E       with --mode auto: the RMSE of linear RGB allowed\n"
 "                      against a converged polarized render, 1e-6..1\n"
 "                      (default 1e-3)\n",
