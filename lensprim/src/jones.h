@@ -126,20 +126,22 @@ LP__INLINE void lp__jones_form(const lp__cm2 *T, double P[3])
     P[2] = T->r01 * T->r01 + T->r11 * T->r11 + T->i01 * T->i01 + T->i11 * T->i11;
 }
 
-/* Node 1 of the view chain, entered from outside along d at the surface
- * normal n, reflected along r with the factors (ar + i ai, br + i bi)
- * (lp__jones_reflection: complex under total internal reflection, when
- * the medium is the denser) and refracted along t with ts, tp: the
- * light's way from node 1 (it refracts out along -d) as R, the light's
- * axes there (s_prev, p_prev) and ok; the form P of the depth-1 query
- * (the light reflecting off the outside, arriving along -r), its entry
- * axes es, ep and qok. */
-LP__INLINE void lp__jones_first(lp_vec3 d, lp_vec3 n, lp_vec3 r, lp_vec3 t, double ar, double ai,
-                                double br, double bi, double ts, double tp, lp__cm2 *R,
-                                lp_vec3 *s_prev, lp_vec3 *p_prev, double *ok, double P[3],
-                                lp_vec3 *es, lp_vec3 *ep, double *qok)
+/* Node 1 of the view chain, entered from outside (index n1) along d at
+ * the surface normal n of the glass (n2), reflected along r with the
+ * factors rs, rp (complex under total internal reflection, when the
+ * medium is the denser: lp__jones_reflection, from tir and cos i = ci)
+ * and refracted along t with ts, tp: the light's way from node 1 (it
+ * refracts out along -d) as R, the light's axes there (s_prev, p_prev)
+ * and ok; the form P of the depth-1 query (the light reflecting off the
+ * outside, arriving along -r), its entry axes es, ep and qok. */
+LP__INLINE void lp__jones_first(lp_vec3 d, lp_vec3 n, lp_vec3 r, lp_vec3 t, double rs, double rp,
+                                int tir, double ci, double n1, double n2, double ts, double tp,
+                                lp__cm2 *R, lp_vec3 *s_prev, lp_vec3 *p_prev, double *ok,
+                                double P[3], lp_vec3 *es, lp_vec3 *ep, double *qok)
 {
     lp_vec3 ap, eap;
+    double ar, ai, br, bi;
+    lp__jones_reflection(rs, rp, tir, ci, n1, n2, &ar, &ai, &br, &bi);
     lp__jones_axes(v3_neg(t), n, v3_neg(d), s_prev, p_prev, &ap, ok);
     *R = lp__jones_diag(ts, 0.0, tp, 0.0);
     lp__jones_axes(v3_neg(r), n, v3_neg(d), es, ep, &eap, qok);
@@ -147,19 +149,22 @@ LP__INLINE void lp__jones_first(lp_vec3 d, lp_vec3 n, lp_vec3 r, lp_vec3 t, doub
     lp__jones_form(&T, P);
 }
 
-/* Node j >= 2 of the view chain, reached along d (inside) over a segment
- * of amplitude factor att, at the surface normal n, reflected along r and
- * refracted out along t with the factors ts, tp (and the reflection's
- * (ar + i ai, br + i bi), lp__jones_reflection): the form P of the query
- * there (the light refracting in, arriving along -t), its entry axes es,
- * ep and qok; then R, s_prev, p_prev and ok grow by the light's
+/* Node j >= 2 of the view chain, reached along d inside the glass (index
+ * n1) over a segment of amplitude factor att, at the surface normal n,
+ * reflected along r with the factors rs, rp (complex under total internal
+ * reflection: lp__jones_reflection, from tir and cos i = ci; n2 the
+ * medium's index) and refracted out along t with ts, tp: the form P of
+ * the query there (the light refracting in, arriving along -t), its entry
+ * axes es, ep and qok; then R, s_prev, p_prev and ok grow by the light's
  * reflection there (arriving along -r), for the queries beyond. */
 LP__INLINE void lp__jones_node(lp_vec3 d, lp_vec3 n, lp_vec3 r, lp_vec3 t, double att,
-                               double ts, double tp, double ar, double ai, double br, double bi,
-                               lp__cm2 *R, lp_vec3 *s_prev, lp_vec3 *p_prev, double *ok,
-                               double P[3], lp_vec3 *es, lp_vec3 *ep, double *qok)
+                               double ts, double tp, double rs, double rp, int tir, double ci,
+                               double n1, double n2, lp__cm2 *R, lp_vec3 *s_prev,
+                               lp_vec3 *p_prev, double *ok, double P[3], lp_vec3 *es,
+                               lp_vec3 *ep, double *qok)
 {
-    double h[4], eok, lok;
+    double h[4], eok, lok, ar, ai, br, bi;
+    lp__jones_reflection(rs, rp, tir, ci, n1, n2, &ar, &ai, &br, &bi);
     lp_vec3 eap, s, p, ap, o = v3_neg(d);
     lp__jones_axes(v3_neg(t), n, o, es, ep, &eap, &eok);
     lp__jones_between(*es, eap, *s_prev, *p_prev, att, h);

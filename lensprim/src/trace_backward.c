@@ -300,13 +300,10 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
     lp_vec3 s_prev = v3(0, 0, 0), p_prev = s_prev, es = s_prev, ep = s_prev;
     double jok = 0.0, qok = 0.0, P[3] = {0.0, 0.0, 0.0};
     lp_vec3 r = lp__node_reflect_dir(&nd), t = lp__node_transmit_dir(&nd);
-    if (power) {
-        double ar, ai, br, bi;
-        lp__jones_reflection(creal(nd.f.rs), creal(nd.f.rp), nd.f.tir, nd.cos_i, o->n_medium,
-                             o->n_glass, &ar, &ai, &br, &bi);
-        lp__jones_first(d, h.n, r, t, ar, ai, br, bi, nd.f.ts, nd.f.tp, &R, &s_prev, &p_prev,
-                        &jok, P, &es, &ep, &qok);
-    }
+    if (power)
+        lp__jones_first(d, h.n, r, t, creal(nd.f.rs), creal(nd.f.rp), nd.f.tir, nd.cos_i,
+                        o->n_medium, o->n_glass, nd.f.ts, nd.f.tp, &R, &s_prev, &p_prev, &jok, P,
+                        &es, &ep, &qok);
     size_t before = bw->n_queries;
     lp__backward_add_query(bw, 1, LP_KIND_REFLECT, h.surface, r, 1u, 0.0,
                            node_bound(&nd, mode, 1), node_weight(&nd, mode, 1));
@@ -350,13 +347,10 @@ static lp_status build_chain(lp_backward *bw, const lp_lens *lens, lp_vec3 origi
         bw->node[depth].surface = h.surface;
         tir = lp__node_setup_fresnel(&nd, d, h.n, o->n_glass, o->n_medium);
         r = lp__node_reflect_dir(&nd), t = lp__node_transmit_dir(&nd);
-        if (power) {
-            double ar, ai, br, bi;
-            lp__jones_reflection(creal(nd.f.rs), creal(nd.f.rp), nd.f.tir, nd.cos_i, o->n_glass,
-                                 o->n_medium, &ar, &ai, &br, &bi);
-            lp__jones_node(d, h.n, r, t, 1.0 + m, nd.f.ts, nd.f.tp, ar, ai, br, bi, &R, &s_prev,
-                           &p_prev, &jok, P, &es, &ep, &qok);
-        }
+        if (power)
+            lp__jones_node(d, h.n, r, t, 1.0 + m, nd.f.ts, nd.f.tp, creal(nd.f.rs),
+                           creal(nd.f.rp), nd.f.tir, nd.cos_i, o->n_glass, o->n_medium, &R,
+                           &s_prev, &p_prev, &jok, P, &es, &ep, &qok);
         before = bw->n_queries;
         if (!tir)
             lp__backward_add_query(bw, depth,
