@@ -227,12 +227,13 @@ static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const in
     }
     for (int g = 0; g < ng; g++) {
         for (size_t m = 0; m < n[g]; m++, k++) {
-            rs_work pb, pa;
+            rs_work pb = {0, 0, 0, 0}, pa;
             unsigned long long s0 = rs_worker_splits(w);
-            rs_worker_work(w, &pb);
+            if (pcost)
+                rs_worker_work(w, &pb);
             rs_integrator_pixel(it, w, px[2 * k], px[2 * k + 1], &out[k]);
-            rs_worker_work(w, &pa);
             if (pcost) {
+                rs_worker_work(w, &pa);
                 rs_work d = {pa.rays - pb.rays, pa.lane_rays - pb.lane_rays,
                              pa.builds - pb.builds, pa.gathered - pb.gathered};
                 pcost[k] = rs_work_cost(&d, opts->mode, 1.0);
@@ -638,38 +639,36 @@ static void consider(choice *best, int *n_cand, double E, choice c)
 static const double TAUS[] = {8.0, 4.0, 2.0, 1.0, 0.5, 0.25, 0.125};
 #define N_TAUS (sizeof TAUS / sizeof *TAUS)
 
-static double change_max(rs_color a, rs_color b)
-{
-    return fmax(fabs(a.r - b.r), fmax(fabs(a.g - b.g), fabs(a.b - b.b)));
-}
-
 /* The probe as the refinement renders it from rung k with tolerance tau
  * (the integrator's rule, rs_integrator_pixel, replayed on the ladder's
  * rungs up to the top, the refinement's last count): each pixel's value
  * into sim, and the cost the renders again add over the image (each pixel
- * standing for pw of its pixels) into *extra, the image's share they
- * render into *share. */
-static void refine_replay(const probe_set *ps, const double *pw, const shot *rung, int n_rungs,
-                          int k, double tau, rs_color *sim, double *extra, double *share)
+ * standing for its group's pixels, as in rms_diff) into *extra, the
+ * image's share they render into *share. */
+static void refine_replay(const probe_set *ps, const shot *rung, int n_rungs, int k, double tau,
+                          rs_color *sim, double *extra, double *share)
 {
-    size_t n = ps->n[G_MARKED] + ps->n[G_LENS] + ps->n[G_OTHER];
+    size_t p = 0;
     double total = 0.0;
     *extra = 0.0;
     *share = 0.0;
-    for (size_t p = 0; p < n; p++) {
-        rs_color v = rung[k].c[p];
-        total += pw[p];
-        if (rung[k].split[p] && k + 1 < n_rungs)
-            *share += pw[p];
-        for (int r = k + 1, calm = 0; r < n_rungs && rung[k].split[p]; r++) {
-            double change = change_max(rung[r].c[p], v);
-            *extra += pw[p] * rung[r].pc[p];
-            v = rung[r].c[p];
-            calm = change > tau || change != change ? 0 : calm + 1;
-            if (calm == 2)
-                break;
+    for (int g = 0; g < N_GROUPS; g++) {
+        double pw = ps->n[g] ? ps->pop[g] / (double)ps->n[g] : 0.0;
+        for (size_t m = 0; m < ps->n[g]; m++, p++) {
+            rs_color v = rung[k].c[p];
+            total += pw;
+            if (rung[k].split[p] && k + 1 < n_rungs)
+                *share += pw;
+            for (int r = k + 1, calm = 0; r < n_rungs && rung[k].split[p]; r++) {
+                double change = rs_refine_change(rung[r].c[p], v);
+                *extra += pw * rung[r].pc[p];
+                v = rung[r].c[p];
+                calm = rs_refine_calm(calm, change, tau);
+                if (calm == RS_REFINE_CALM)
+                    break;
+            }
+            sim[p] = v;
         }
-        sim[p] = v;
     }
     *share = total > 0.0 ? *share / total : 0.0;
 }
@@ -677,7 +676,7 @@ static void refine_replay(const probe_set *ps, const double *pw, const shot *run
 /* The cheapest candidate whose estimate is within E (cost < 0: none),
  * from the measurements so far (see auto_settings.h); *n_cand counts
  * the candidates.  sim: room for the probe's pixels. */
-static choice choose(const probe_set *ps, const double *pw, double E, int pol_only, rs_mode L,
+static choice choose(const probe_set *ps, double E, int pol_only, rs_mode L,
                      const tree *tr, int n_trees, int t_lad, const shot *rung, const int *rung_n,
                      int n_rungs, double e_top, const double *e_model, const double *mcost,
                      const shot *rgb, rs_color *sim, int *n_cand)
@@ -695,7 +694,7 @@ static choice choose(const probe_set *ps, const double *pw, double E, int pol_on
             if (ti < 0) {
                 e_wl = (k == n_rungs - 1 ? 0.0 : rms_diff(ps, rung[k].c, top->c)) + e_t;
             } else {
-                refine_replay(ps, pw, rung, n_rungs, k, tau, sim, &extra, &share);
+                refine_replay(ps, rung, n_rungs, k, tau, sim, &extra, &share);
                 if (share <= 0.0)
                     break; /* no pixel split: nothing to refine */
                 /* A refined pixel is left within about tau of its
@@ -751,7 +750,6 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     int depths[4], n_depths = 0, depth_max;
     rs_render_opts o;
     choice best = {RS_MODE_POLARIZED, 0, 0, 0, INFINITY, 0, 0, 0, -1.0, 0.0, 0.0};
-    double *pw = NULL;    /* per probe pixel: the image's pixels it stands for */
     rs_color *sim = NULL; /* the probe as a refinement renders it */
 
     memset(tr, 0, sizeof tr);
@@ -808,17 +806,10 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         if (probe_pick(scene, &pilot, pol_reason != NULL, &ps, &spent, msg, msg_size) != 0)
             return -1;
     }
-    {
-        size_t n = ps.n[G_MARKED] + ps.n[G_LENS] + ps.n[G_OTHER], k = 0;
-        pw = malloc(sizeof *pw * (n + 1));
-        sim = malloc(sizeof *sim * (n + 1));
-        if (!pw || !sim) {
-            snprintf(msg, msg_size, "out of memory");
-            goto done;
-        }
-        for (int g = 0; g < N_GROUPS; g++)
-            for (size_t m = 0; m < ps.n[g]; m++)
-                pw[k++] = ps.pop[g] / (double)ps.n[g];
+    sim = malloc(sizeof *sim * (ps.n[G_MARKED] + ps.n[G_LENS] + ps.n[G_OTHER] + 1));
+    if (!sim) {
+        snprintf(msg, msg_size, "out of memory");
+        goto done;
     }
 
     /* Every tree, in rgb (cheap, and each an rgb candidate) or, where the
@@ -875,7 +866,7 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     n_rungs = 1;
     for (;;) {
         double before = spent;
-        best = choose(&ps, pw, E, pol_reason != NULL, L, tr, n_trees, t_lad, rung, rung_n,
+        best = choose(&ps, E, pol_reason != NULL, L, tr, n_trees, t_lad, rung, rung_n,
                       n_rungs, e_top, e_model, mcost, rgb, sim, &n_cand);
         if (req->wavelengths > 0 || rung_n[n_rungs - 1] >= WAVELENGTHS_MAX ||
             n_rungs == RUNGS_MAX || (n_rungs > 1 && e_top <= TOP_SHARE * E) ||
@@ -964,7 +955,6 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     rc = 0;
 done:
     free(ps.px);
-    free(pw);
     free(sim);
     for (int t = 0; t < n_trees; t++)
         shot_free(&tr[t].s);

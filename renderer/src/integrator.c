@@ -2361,9 +2361,9 @@ void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs
             return;
         const rs_integrator *fi = fw->it;
         pixel_at(fi, fw, i, j, &c);
-        double change = fmax(fabs(c.r - out->r), fmax(fabs(c.g - out->g), fabs(c.b - out->b)));
+        double change = rs_refine_change(c, *out);
         *out = c;
-        calm = change > it->opts.refine_tol || change != change ? 0 : calm + 1;
+        calm = rs_refine_calm(calm, change, it->opts.refine_tol);
         if (!has_finer(fi))
             return;
         if (fi->opts.wavelengths >= it->opts.refine_max) {
@@ -2371,7 +2371,7 @@ void rs_integrator_pixel(const rs_integrator *it, rs_worker *w, int i, int j, rs
              * refine_outlier */
             if (!(change > it->opts.refine_outlier))
                 return;
-        } else if (calm == 2) {
+        } else if (calm == RS_REFINE_CALM) {
             return;
         }
         it = fi;

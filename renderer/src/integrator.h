@@ -12,6 +12,7 @@
 #ifndef RS_INTEGRATOR_H
 #define RS_INTEGRATOR_H
 
+#include <math.h>
 #include <stddef.h>
 
 #include "scene.h"
@@ -84,6 +85,24 @@ typedef struct rs_work {
 } rs_work;
 
 void rs_worker_work(const rs_worker *w, rs_work *out);
+
+/* The refinement's rule (rs_render_opts.refine_tol), one definition for
+ * the integrator and for auto's replay of it: a doubling's change is the
+ * pixel's largest channel difference; calm counts the doublings in a row
+ * that changed it by at most the tolerance (a NaN change breaks the row),
+ * and the pixel stops at RS_REFINE_CALM of them. */
+#define RS_REFINE_CALM 2
+
+static inline double rs_refine_change(rs_color a, rs_color b)
+{
+    double dr = a.r - b.r, dg = a.g - b.g, db = a.b - b.b;
+    return fmax(fabs(dr), fmax(fabs(dg), fabs(db)));
+}
+
+static inline int rs_refine_calm(int calm, double change, double tol)
+{
+    return change > tol || change != change ? 0 : calm + 1;
+}
 
 /* How many lens hits of the worker's so far split a spectral packet
  * (lanes of different optics there: a dispersive lens).  A pixel whose
