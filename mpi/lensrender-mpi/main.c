@@ -162,7 +162,7 @@ static int render(mw_group *g, const rs_args *a, ctx *c)
     char msg[MSG_MAX] = "";
     lr_error err;
     lr_load_opts lo;
-    lr_render_opts ro, used;
+    lr_render_opts ro;
     lr_scene *scene = NULL;
     lr_renderer *r = NULL;
     mw_job job;
@@ -189,7 +189,6 @@ static int render(mw_group *g, const rs_args *a, ctx *c)
         rs_print_scene_messages(PROGRAM, scene);
     if ((status = agree(g, status, msg)) != 0)
         goto done;
-    lr_renderer_settings(r, &used);
     if (lead && a->mode_auto && !a->quiet)
         sp_say(PROGRAM, "auto: %s", lr_renderer_explanation(r));
 
@@ -220,10 +219,9 @@ static int render(mw_group *g, const rs_args *a, ctx *c)
     if ((status = agree(g, status, msg)) != 0)
         goto done;
     if (lead && !a->quiet)
-        sp_say(PROGRAM, "wrote %s%s%s (%d x %d, %s, %d wavelengths, depth %d) in %.2f s on %d "
-               "process%s x %d thread%s", a->out_png, a->pfm ? " and " : "",
-               a->pfm ? a->pfm : "", a->width, a->height, lr_mode_name(used.mode),
-               used.wavelengths, used.depth, sp_now_seconds() - t0, c->size,
+        sp_say(PROGRAM, "wrote %s%s%s (%d x %d, %s) in %.2f s on %d process%s x %d thread%s",
+               a->out_png, a->pfm ? " and " : "", a->pfm ? a->pfm : "", a->width, a->height,
+               lr_renderer_description(r), sp_now_seconds() - t0, c->size,
                c->size == 1 ? "" : "es", ro.threads, ro.threads == 1 ? "" : "s");
 done:
     lr_renderer_free(r);

@@ -17,6 +17,7 @@
 #define SHARE_CUTOFF 0.1  /* of E: the radiance one dropped branch may carry */
 #define TOP_SHARE 0.125   /* of E: the ladder's top rung's error, at most */
 #define TREE_LADDER 0.25  /* of E: the ladder's tree's error, at most */
+#define TREE_COST_MAX 64.0 /* of the cheapest tree's cost: the dearest probed */
 #define CLIMB_SHARE 0.05  /* of the best render's cost: a rung the probe may add */
 #define DEPTH_MIN 32      /* the deepest tree, unless the scene asks for more */
 #define DEEP_CUT_DEPTH 16 /* cut-offs below 1e-6 only at this depth and deeper */
@@ -207,16 +208,22 @@ static int may_see_lens(const rs_scene *s, const lens_boxes *lb, lp_vec3 o, lp_v
  * renders (rs_work_cost) into gcost[g], their work into gwork[g] (when
  * not NULL) and the costs' sum added to *spent.  When not NULL, pcost[k]
  * gets pixel k's own cost and split[k] whether its spectral packet split
- * at a lens (rs_worker_splits). */
+ * at a lens (rs_worker_splits).  pop (when not NULL, with cap > 0): the
+ * pixels each group stands for; once the cost over them (each pixel's
+ * cost times the pixels it stands for, summed in order) passes cap, the
+ * render stops and returns 1 (out, gcost and the rest then undefined;
+ * *spent gets what it rendered). */
 static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const int *px,
-                         const size_t *n, int ng, rs_color *out, double *gcost, rs_work *gwork,
-                         double *pcost, unsigned char *split, double *spent, char *msg,
-                         size_t msg_size)
+                         const size_t *n, int ng, const double *pop, double cap, rs_color *out,
+                         double *gcost, rs_work *gwork, double *pcost, unsigned char *split,
+                         double *spent, char *msg, size_t msg_size)
 {
     rs_integrator *it;
     rs_worker *w;
     rs_work before = {0, 0, 0, 0}, after;
     size_t k = 0;
+    double image = 0.0; /* the cost over the image so far, where capped */
+    int rc = 0;
     if (rs_integrator_create(s, opts, &it, msg, msg_size) != 0)
         return -1;
     w = rs_worker_create(it);
@@ -225,21 +232,24 @@ static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const in
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
-    for (int g = 0; g < ng; g++) {
-        for (size_t m = 0; m < n[g]; m++, k++) {
+    for (int g = 0; g < ng && rc == 0; g++) {
+        for (size_t m = 0; m < n[g] && rc == 0; m++, k++) {
             rs_work pb = {0, 0, 0, 0}, pa;
             unsigned long long s0 = rs_worker_splits(w);
-            if (pcost)
-                rs_worker_work(w, &pb);
+            rs_worker_work(w, &pb);
             rs_integrator_pixel(it, w, px[2 * k], px[2 * k + 1], &out[k]);
-            if (pcost) {
-                rs_worker_work(w, &pa);
-                rs_work d = {pa.rays - pb.rays, pa.lane_rays - pb.lane_rays,
-                             pa.builds - pb.builds, pa.gathered - pb.gathered};
-                pcost[k] = rs_work_cost(&d, opts->mode, 1.0);
-            }
+            rs_worker_work(w, &pa);
+            rs_work d = {pa.rays - pb.rays, pa.lane_rays - pb.lane_rays, pa.builds - pb.builds,
+                         pa.gathered - pb.gathered};
+            double c = rs_work_cost(&d, opts->mode, 1.0);
+            if (pcost)
+                pcost[k] = c;
             if (split)
                 split[k] = rs_worker_splits(w) != s0;
+            if (pop && cap > 0.0) {
+                image += c * pop[g] / (double)n[g];
+                rc = image > cap;
+            }
         }
         rs_worker_work(w, &after);
         rs_work d = {after.rays - before.rays, after.lane_rays - before.lane_rays,
@@ -252,7 +262,7 @@ static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const in
     }
     rs_worker_destroy(w);
     rs_integrator_destroy(it);
-    return 0;
+    return rc;
 }
 
 typedef struct scored {
@@ -335,7 +345,7 @@ static int pilot_mark(const rs_scene *s, const rs_render_opts *base, int polariz
     f.wavelengths = 1;
     {
         double gc;
-        if (render_pixels(s, &f, px, &n, 1, c, &gc, NULL, NULL, NULL, spent, msg, msg_size) != 0)
+        if (render_pixels(s, &f, px, &n, 1, NULL, 0.0, c, &gc, NULL, NULL, NULL, spent, msg, msg_size) != 0)
             goto out;
     }
     for (int pass = 0; pass < (polarized ? 1 : 2); pass++) {
@@ -472,9 +482,14 @@ static void shot_free(shot *s)
     s->split = NULL;
 }
 
-static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set *ps, shot *out,
-                 double *spent, char *msg, size_t msg_size)
+static void shot_free(shot *s);
+
+/* cap > 0: a render whose cost over the image would pass it stops and
+ * returns 1, *out left empty. */
+static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set *ps, double cap,
+                 shot *out, double *spent, char *msg, size_t msg_size)
 {
+    int rc;
     double gc[N_GROUPS];
     size_t n = ps->n[G_MARKED] + ps->n[G_LENS] + ps->n[G_OTHER];
     out->c = malloc(sizeof *out->c * (n + 1));
@@ -484,9 +499,12 @@ static int probe(const rs_scene *s, const rs_render_opts *opts, const probe_set 
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
-    if (render_pixels(s, opts, ps->px, ps->n, N_GROUPS, out->c, gc, out->work, out->pc,
-                      out->split, spent, msg, msg_size) != 0)
-        return -1;
+    rc = render_pixels(s, opts, ps->px, ps->n, N_GROUPS, ps->pop, cap, out->c, gc, out->work,
+                       out->pc, out->split, spent, msg, msg_size);
+    if (rc != 0) {
+        shot_free(out);
+        return rc;
+    }
     out->cost = 0.0;
     for (int g = 0; g < N_GROUPS; g++)
         if (ps->n[g])
@@ -559,6 +577,8 @@ typedef struct tree {
     double cutoff;
     shot s;    /* the ladder's model at the first rung */
     double e;  /* e_tree */
+    int over;  /* not probed: it would cost more than TREE_COST_MAX x the
+                  cheapest (s empty) */
 } tree;
 
 /* Does tree b trace every ray tree a traces?  It does where it is no
@@ -569,51 +589,81 @@ static int nests(const tree *a, const tree *b)
     return a->depth <= b->depth && a->cutoff >= b->cutoff;
 }
 
-/* Every tree's probe render with base at its depth and cut-off (the
- * trees depth by depth, shallowest first; each depth's cut-offs loosest
- * first).  A tree t between two rendered trees a and b (a nests in t, t
- * in b) that traced the same -- every counter of every group -- traces
- * what a traces and renders as a does: it is copied, not rendered.  So
- * the deepest depth goes first, then the shallowest, then the others
- * shallow to deep, each depth's tightest cut-off first, then its loosest,
- * then the others loose to tight: an equal pair then stands for the
- * trees between (a scene whose light is all traced by depth 8 renders
- * depth 16 as 8 and 32). */
+/* Every tree's probe render with base at its depth and cut-off, but
+ * those that would cost more than TREE_COST_MAX times the cheapest (the
+ * shallowest, loosest: rendered first), which are marked over.  A tree t
+ * between two rendered trees a and b (a nests in t, t in b) that traced
+ * the same -- every counter of every group -- traces what a traces and
+ * renders as a does: it is copied, not rendered.  So the deepest depth
+ * goes first, then the shallowest, then the others shallow to deep (a
+ * scene whose light is all traced by depth 8 renders depth 16 as 8 and
+ * 32); each depth's cut-offs loosest first, so that a tree's cost is
+ * foretold by the two looser ones before it (the growth per decade of
+ * cut-off kept): one foretold to pass the cap 4 times over is not
+ * started, and the render of one that passes it stops there (a faint
+ * branch's descendants can cost a thousand times the main rays: the
+ * microscope's ten surfaces at depth 32 and a 4-wavelength probe, 0.05 s
+ * for 192 pixels at cut-off 1e-2, 1.1 s at 1e-4, 45 s at 1e-6).  A tree
+ * tighter than an over one at its depth is over too. */
 static int probe_trees(const rs_scene *s, const rs_render_opts *base, const probe_set *ps,
                        tree *tr, int n_trees, double *spent, char *msg, size_t msg_size)
 {
     int first[TREES_MAX + 1], n_depths = 0, order[TREES_MAX], n_order = 0;
     int done[TREES_MAX];
+    double cap = 0.0;
     for (int t = 0; t < n_trees; t++) {
         done[t] = 0;
+        tr[t].over = 0;
         if (t == 0 || tr[t].depth != tr[t - 1].depth)
             first[n_depths++] = t;
     }
     first[n_depths] = n_trees;
+    order[n_order++] = 0; /* the cheapest: the cap's measure */
     for (int k = 0; k < n_depths; k++) {
-        int d = k == 0 ? n_depths - 1 : k - 1, b0 = first[d], b1 = first[d + 1];
-        order[n_order++] = b1 - 1;
-        for (int t = b0; t < b1 - 1; t++)
-            order[n_order++] = t;
+        int d = k == 0 ? n_depths - 1 : k - 1;
+        for (int t = first[d]; t < first[d + 1]; t++)
+            if (t != 0)
+                order[n_order++] = t;
     }
     for (int k = 0; k < n_order; k++) {
-        int t = order[k], a = -1;
+        int t = order[k], a = -1, rc;
         for (int i = 0; i < n_trees && a < 0; i++)
             for (int j = 0; j < n_trees && a < 0; j++)
-                if (done[i] && done[j] && nests(&tr[i], &tr[t]) && nests(&tr[t], &tr[j]) &&
-                    same_work(&tr[i].s, &tr[j].s))
+                if (done[i] && done[j] && !tr[i].over && !tr[j].over && nests(&tr[i], &tr[t]) &&
+                    nests(&tr[t], &tr[j]) && same_work(&tr[i].s, &tr[j].s))
                     a = i;
+        done[t] = 1;
         if (a >= 0) {
             if (shot_copy(ps, &tr[a].s, &tr[t].s, msg, msg_size) != 0)
                 return -1;
-        } else {
-            rs_render_opts f = *base;
-            f.depth = tr[t].depth;
-            f.cutoff = tr[t].cutoff;
-            if (probe(s, &f, ps, &tr[t].s, spent, msg, msg_size) != 0)
-                return -1;
+            continue;
         }
-        done[t] = 1;
+        /* the looser trees of its depth, rendered before it */
+        if (t > 0 && tr[t - 1].depth == tr[t].depth) {
+            const tree *p = &tr[t - 1];
+            if (p->over) {
+                tr[t].over = 1;
+                continue;
+            }
+            if (t > 1 && tr[t - 2].depth == tr[t].depth && !tr[t - 2].over) {
+                const tree *q = &tr[t - 2];
+                double per = log(p->s.cost / q->s.cost) / log10(q->cutoff / p->cutoff);
+                double foretold = p->s.cost * exp(fmax(0.0, per) * log10(p->cutoff / tr[t].cutoff));
+                if (cap > 0.0 && foretold > 4.0 * cap) {
+                    tr[t].over = 1;
+                    continue;
+                }
+            }
+        }
+        rs_render_opts f = *base;
+        f.depth = tr[t].depth;
+        f.cutoff = tr[t].cutoff;
+        rc = probe(s, &f, ps, cap, &tr[t].s, spent, msg, msg_size);
+        if (rc < 0)
+            return -1;
+        tr[t].over = rc == 1;
+        if (t == 0)
+            cap = TREE_COST_MAX * tr[0].s.cost;
     }
     return 0;
 }
@@ -707,6 +757,8 @@ static choice choose(const probe_set *ps, double E, int pol_only, rs_mode L,
                 e_wl = rms_diff(ps, sim, top->c) + e_t;
             }
             for (int t = 0; t < n_trees; t++) {
+                if (tr[t].over)
+                    continue;
                 double tcost = tr[t].s.cost / tr[t_lad].s.cost;
                 for (int m = 0; m < 3; m++) {
                     if (pol_only && spectral[m] != RS_MODE_POLARIZED)
@@ -740,6 +792,7 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
     const rs_mode L = pol_reason ? RS_MODE_POLARIZED : RS_MODE_FRESNEL;
     double lmax = radiance_max(scene), spent = 0.0, budget, floor_cut, e_star;
     int rc = -1, n_lenses, n_trees = 0, n_rungs = 0, t_star, t_lad, n_cand = 0, over = 0;
+    int n_over = 0; /* trees too dear to probe */
     double dn = dispersion_max(scene, &n_lenses);
     probe_set ps = {NULL, {0, 0, 0}, {0, 0, 0}, 0.0, {0, 0, 0}};
     tree tr[TREES_MAX];
@@ -823,13 +876,21 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
             goto done;
     }
     for (int t = 0; t < n_trees && !pol_reason; t++)
-        rgb[t] = tr[t].s; /* not owned */
+        rgb[t] = tr[t].s; /* not owned; empty where over */
+    /* T*: the deepest depth's lowest cut-off, or where trees were too
+     * dear to probe, the dearest probed (the one that traces the most) */
     for (int t = 0; t < n_trees; t++)
-        tr[t].e = rms_diff(&ps, tr[t].s.c, tr[t_star].s.c) + e_star;
+        if (tr[t].over)
+            n_over++;
+        else if (tr[t_star].over || tr[t].s.cost > tr[t_star].s.cost)
+            t_star = t;
+    for (int t = 0; t < n_trees; t++)
+        if (!tr[t].over)
+            tr[t].e = rms_diff(&ps, tr[t].s.c, tr[t_star].s.c) + e_star;
     /* The ladder's tree: the cheapest within TREE_LADDER of E. */
     t_lad = t_star;
     for (int t = 0; t < n_trees; t++)
-        if (tr[t].e <= TREE_LADDER * E && tr[t].s.cost < tr[t_lad].s.cost)
+        if (!tr[t].over && tr[t].e <= TREE_LADDER * E && tr[t].s.cost < tr[t_lad].s.cost)
             t_lad = t;
 
     /* The ladder's first rung, and the models there: their departure from
@@ -841,14 +902,14 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         /* where the scene needs polarized, the trees were rendered in L
          * at the first rung: the ladder's tree is that rung already */
         if ((pol_reason ? shot_copy(&ps, &tr[t_lad].s, &rung[0], msg, msg_size)
-                        : probe(scene, &f, &ps, &rung[0], &spent, msg, msg_size)) != 0)
+                        : probe(scene, &f, &ps, 0.0, &rung[0], &spent, msg, msg_size)) != 0)
             goto done;
         if (!pol_reason) {
             f.mode = RS_MODE_POLARIZED;
-            if (probe(scene, &f, &ps, &pol, &spent, msg, msg_size) != 0)
+            if (probe(scene, &f, &ps, 0.0, &pol, &spent, msg, msg_size) != 0)
                 goto done;
             f.mode = RS_MODE_SCHLICK;
-            if (probe(scene, &f, &ps, &sch, &spent, msg, msg_size) != 0)
+            if (probe(scene, &f, &ps, 0.0, &sch, &spent, msg, msg_size) != 0)
                 goto done;
             e_model[RS_MODE_FRESNEL] = rms_diff(&ps, rung[0].c, pol.c);
             e_model[RS_MODE_SCHLICK] = rms_diff(&ps, sch.c, pol.c);
@@ -876,7 +937,7 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
         f.depth = tr[t_lad].depth;
         f.cutoff = tr[t_lad].cutoff;
         f.wavelengths = 2 * rung_n[n_rungs - 1];
-        if (probe(scene, &f, &ps, &rung[n_rungs], &spent, msg, msg_size) != 0)
+        if (probe(scene, &f, &ps, 0.0, &rung[n_rungs], &spent, msg, msg_size) != 0)
             goto done;
         rung_spent = spent - before;
         rung_n[n_rungs] = f.wavelengths;
@@ -914,8 +975,14 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
                      ", refined up to %d where a doubling changes a pixel by more than %.2g "
                      "(%.0f %% of the image split at a lens)",
                      o.refine_max, best.tau, 100.0 * best.refined);
-        char model[160], lens[160], parts[160];
+        char model[160], lens[160], parts[160], dear[224] = "";
         size_t n = ps.n[G_MARKED] + ps.n[G_LENS] + ps.n[G_OTHER];
+        if (n_over)
+            snprintf(dear, sizeof dear,
+                     "; %d of %d trees not probed, each over %.0f x the cheapest's cost: the "
+                     "trees' error is against depth %d, cut-off %.3g, and what fainter or deeper "
+                     "branches add is not in the estimate",
+                     n_over, n_trees, TREE_COST_MAX, tr[t_star].depth, tr[t_star].cutoff);
         if (pol_reason)
             snprintf(model, sizeof model, "polarized only: %s", pol_reason);
         else
@@ -934,18 +1001,18 @@ int rs_auto_choose(const rs_scene *scene, const rs_auto_request *req, rs_render_
             snprintf(why, why_size,
                      "rgb, depth %d, cut-off %.3g for E = %.3g: estimated error %.2g (%s), the "
                      "cheapest of %d candidates; %s; %s; probe %zu pixels, %.0f %% of the render's "
-                     "cost",
+                     "cost%s",
                      o.depth, o.cutoff, E, best.e, parts, n_cand, model, lens, n,
-                     100.0 * spent / best.cost);
+                     100.0 * spent / best.cost, dear);
         else
             snprintf(why, why_size,
                      "%s, %d wavelengths%s%s, depth %d, cut-off %.3g for E = %.3g: estimated error "
                      "%.2g (%s)%s, the cheapest of %d candidates; %s; %s; probe %zu pixels, %.0f %% "
-                     "of the render's cost",
+                     "of the render's cost%s",
                      rs_mode_name(o.mode), o.wavelengths, req->wavelengths > 0 ? " (yours)" : "",
                      refine, o.depth, o.cutoff, E, best.e, parts,
                      over ? ", over E: no candidate meets it" : "", n_cand, model, lens, n,
-                     100.0 * spent / best.cost);
+                     100.0 * spent / best.cost, dear);
     }
     *out = o;
     if (cost) {

@@ -22,6 +22,7 @@
 #define TILE_SIZE 16
 #define MSG_MAX 1024
 #define WHY_MAX 1024
+#define DESCRIPTION_MAX 160
 
 struct lr_scene {
     rs_scene s;
@@ -35,6 +36,7 @@ struct lr_renderer {
     rs_integrator *it;
     lr_render_opts settings;   /* as rendered (lr_renderer_settings) */
     char why[WHY_MAX];         /* auto's explanation, or "" */
+    char what[DESCRIPTION_MAX]; /* lr_renderer_description */
 };
 
 /* ---- errors ------------------------------------------------------------ */
@@ -351,6 +353,26 @@ static const char *opts_problem(const lr_render_opts *o)
 
 /* ---- renderers --------------------------------------------------------- */
 
+/* lr_renderer_description's phrase, from the settings as rendered and
+ * the integrator's options (where auto refines pixels). */
+static void describe(const lr_render_opts *used, const rs_render_opts *ro, char *out,
+                     size_t size)
+{
+    char wl[96] = "";
+    if (used->mode != LR_MODE_RGB && ro->refine_tol > 0.0 && ro->refine_max > used->wavelengths) {
+        if (ro->refine_outlier > 0.0 && ro->refine_limit > ro->refine_max)
+            snprintf(wl, sizeof wl, "%d wavelengths, refined per pixel up to %d (outliers %d), ",
+                     used->wavelengths, ro->refine_max, ro->refine_limit);
+        else
+            snprintf(wl, sizeof wl, "%d wavelengths, refined per pixel up to %d, ",
+                     used->wavelengths, ro->refine_max);
+    } else if (used->mode != LR_MODE_RGB) {
+        snprintf(wl, sizeof wl, "%d wavelength%s, ", used->wavelengths,
+                 used->wavelengths == 1 ? "" : "s");
+    }
+    snprintf(out, size, "%s, %sdepth %d", lr_mode_name(used->mode), wl, used->depth);
+}
+
 lr_status lr_renderer_create(lr_scene *scene, const lr_render_opts *opts, lr_renderer **out,
                              lr_error *err)
 {
@@ -416,6 +438,7 @@ lr_status lr_renderer_create(lr_scene *scene, const lr_render_opts *opts, lr_ren
     r->settings.cutoff = ro.cutoff >= 0.0 ? ro.cutoff : scene->s.settings.adc_bailout;
     if (opts->tolerance <= 0.0 && opts->mode == LR_MODE_AUTO)
         r->settings.tolerance = LR_TOLERANCE_DEFAULT;
+    describe(&r->settings, &ro, r->what, sizeof r->what);
     *out = r;
     if (err)
         memset(err, 0, sizeof *err);
@@ -428,6 +451,11 @@ void lr_renderer_free(lr_renderer *r)
         return;
     rs_integrator_destroy(r->it);
     free(r);
+}
+
+const char *lr_renderer_description(const lr_renderer *r)
+{
+    return r->what;
 }
 
 void lr_renderer_settings(const lr_renderer *r, lr_render_opts *out)

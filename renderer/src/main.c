@@ -103,7 +103,7 @@ static int run(const rs_args *a)
     char msg[MSG_MAX] = "";
     lr_error err;
     lr_load_opts lo;
-    lr_render_opts ro, used;
+    lr_render_opts ro;
     lr_scene *scene = NULL;
     lr_renderer *r = NULL;
     rs_image img;
@@ -132,7 +132,6 @@ static int run(const rs_args *a)
     }
     if (a->mode_auto && !a->quiet)
         fprintf(stderr, "lensrender: auto: %s\n", lr_renderer_explanation(r));
-    lr_renderer_settings(r, &used);
 
     if (rs_image_create(&img, a->width, a->height) != 0) {
         say("out of memory for the image");
@@ -165,10 +164,8 @@ static int run(const rs_args *a)
     }
     if (!a->quiet)
         fprintf(stderr,
-                "lensrender: wrote %s (%d x %d, %s, %d wavelengths, depth %d) "
-                "in %.2f s\n",
-                a->out_png, a->width, a->height, lr_mode_name(used.mode),
-                used.wavelengths, used.depth, sp_now_seconds() - t0);
+                "lensrender: wrote %s (%d x %d, %s) in %.2f s\n", a->out_png, a->width,
+                a->height, lr_renderer_description(r), sp_now_seconds() - t0);
 
 done:
     rs_image_free(&img);

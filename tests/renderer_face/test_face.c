@@ -219,6 +219,18 @@ int main(void)
               "settings: fresnel, 4 wavelengths, the scene's depth 6 (got %s %d %d)",
               lr_mode_name(used.mode), used.wavelengths, used.depth);
         CHECK(strcmp(lr_renderer_explanation(r), "") == 0, "no explanation outside auto");
+        CHECK(strcmp(lr_renderer_description(r), "fresnel, 4 wavelengths, depth 6") == 0,
+              "description: %s", lr_renderer_description(r));
+    }
+    {
+        lr_renderer *rr = NULL;
+        lr_render_opts rgb = ro;
+        rgb.mode = LR_MODE_RGB;
+        rgb.depth = 3;
+        CHECK(lr_renderer_create(scene, &rgb, &rr, &err) == LR_OK && rr &&
+                  strcmp(lr_renderer_description(rr), "rgb, depth 3") == 0,
+              "an rgb renderer says no wavelengths: %s", rr ? lr_renderer_description(rr) : "");
+        lr_renderer_free(rr);
     }
     progress_log pl = {0, 1, 0, 0, 0};
     CHECK(lr_render_image(r, ref, on_progress, &pl, &err) == LR_OK, "render: %s", err.message);
@@ -307,6 +319,10 @@ int main(void)
                 continue;
             }
             refined += strstr(lr_renderer_explanation(ra), "refined") != NULL;
+            CHECK((strstr(lr_renderer_explanation(ra), "refined") != NULL) ==
+                      (strstr(lr_renderer_description(ra), "refined per pixel up to") != NULL),
+                  "the description says where auto refines: %s | %s",
+                  lr_renderer_description(ra), lr_renderer_explanation(ra));
             CHECK(strcmp(lr_renderer_explanation(ra), lr_renderer_explanation(rb)) == 0,
                   "auto chooses the same whatever the threads");
             CHECK(lr_render_image(ra, aref, NULL, NULL, &err) == LR_OK &&

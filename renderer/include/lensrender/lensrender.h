@@ -277,6 +277,13 @@ void lr_renderer_settings(const lr_renderer *renderer, lr_render_opts *out);
  * why; "" for the other modes.  Belongs to the renderer. */
 const char *lr_renderer_explanation(const lr_renderer *renderer);
 
+/* What the renderer renders with, in a few words (no newline), for a
+ * driver's last line: "polarized, 16 wavelengths, depth 5"; "rgb,
+ * depth 8" (rgb has no wavelengths); where auto refines pixels "polarized,
+ * 4 wavelengths, refined per pixel up to 1024 (outliers 16384), depth 8".
+ * Belongs to the renderer. */
+const char *lr_renderer_description(const lr_renderer *renderer);
+
 /* Progress, called from the calling thread only (never concurrently):
  * done pixels of total in this render so far, about 10 times a second
  * and once when every pixel is done.  Return 0 to go on; nonzero cancels:
