@@ -318,6 +318,30 @@ static void one_scene(const shipped_scene *ss)
     rs_scene_free(&sc);
 }
 
+/* Auto's choice alone (no render) on a scene read from path or, when
+ * path is NULL, from text, at w x h and tolerance E; its line printed
+ * after name.  Returns 0, or -1 (a failed check). */
+static int choice_only(const char *name, const char *path, const char *text, int w, int h,
+                       double E, rs_render_opts *ch, char *why, size_t why_size)
+{
+    char msg[512];
+    rs_scene sc;
+    rs_auto_request req = {E, w, h, 0, 0, -1.0};
+    int ok;
+    rs_scene_init(&sc);
+    if (load_scene(&sc, path, text, path ? NULL : name, w, h) != 0) {
+        CHECK(0, "%s: loads", name);
+        rs_scene_free(&sc);
+        return -1;
+    }
+    ok = rs_auto_choose(&sc, &req, ch, NULL, why, why_size, msg, sizeof msg) == 0;
+    CHECK(ok, "%s: auto chooses (%s)", name, msg);
+    if (ok)
+        fprintf(stderr, "%s E=%g at %dx%d: %s\n", name, E, w, h, why);
+    rs_scene_free(&sc);
+    return ok ? 0 : -1;
+}
+
 /* No lens, no dispersion, no polarizer: the unpolarized model and few
  * wavelengths (only Smits' reflectance bins make the spectrum vary). */
 static void plain_scene(void)
@@ -327,22 +351,11 @@ static void plain_scene(void)
         "light_source { <10, 20, -10> color rgb 1 }\n"
         "plane { y, 0 pigment { checker rgb 1, rgb 0.2 } }\n"
         "sphere { <0, 1, 0>, 1 pigment { color rgb <1, 0.5, 0.2> } }\n";
-    char msg[512], why[1024];
-    rs_scene sc;
+    char why[1024];
     rs_render_opts ch;
-    rs_auto_request req = {1e-2, W, H, 0, 0, -1.0};
-    rs_scene_init(&sc);
-    if (load_scene(&sc, NULL, text, "<plain>", W, H) != 0) {
-        CHECK(0, "plain scene loads");
-        rs_scene_free(&sc);
-        return;
-    }
-    CHECK(rs_auto_choose(&sc, &req, &ch, NULL, why, sizeof why, msg, sizeof msg) == 0,
-          "plain: %s", msg);
-    fprintf(stderr, "plain: %s\n", why);
-    CHECK(ch.mode == RS_MODE_RGB || (ch.mode != RS_MODE_POLARIZED && ch.wavelengths <= 8),
-          "plain scene: cheap (%s)", why);
-    rs_scene_free(&sc);
+    if (choice_only("<plain>", NULL, text, W, H, 1e-2, &ch, why, sizeof why) == 0)
+        CHECK(ch.mode == RS_MODE_RGB || (ch.mode != RS_MODE_POLARIZED && ch.wavelengths <= 8),
+              "plain scene: cheap (%s)", why);
 }
 
 static void every_scene_listed(void)
@@ -375,23 +388,12 @@ static void every_scene_listed(void)
  * Only the choice: its render takes hundreds of wavelengths. */
 static void dear_trees(void)
 {
-    char path[1024], why[1024], msg[512];
-    rs_scene sc;
+    char path[1024], why[1024];
     rs_render_opts ch;
-    rs_auto_request req = {1e-3, 8, 6, 0, 0, -1.0};
     snprintf(path, sizeof path, "%s/scenes/microscope/microscope.scene", LP_SOURCE_DIR);
-    rs_scene_init(&sc);
-    if (load_scene(&sc, path, NULL, NULL, 8, 6) != 0) {
-        CHECK(0, "microscope: loads");
-        rs_scene_free(&sc);
-        return;
-    }
-    CHECK(rs_auto_choose(&sc, &req, &ch, NULL, why, sizeof why, msg, sizeof msg) == 0,
-          "microscope: auto chooses (%s)", msg);
-    fprintf(stderr, "microscope E=0.001 at 8x6: %s\n", why);
-    CHECK(strstr(why, "not probed, each over 64 x the cheapest's cost") != NULL,
-          "microscope: its dearest trees not probed (%s)", why);
-    rs_scene_free(&sc);
+    if (choice_only("microscope", path, NULL, 8, 6, 1e-3, &ch, why, sizeof why) == 0)
+        CHECK(strstr(why, "not probed, each over 64 x the cheapest's cost") != NULL,
+              "microscope: its dearest trees not probed (%s)", why);
 }
 
 int main(void)
