@@ -21,18 +21,20 @@ static double change_of(const rs_image *last, long k)
     return fmax(fabs((double)c[0]), fmax(fabs((double)c[1]), fabs((double)c[2])));
 }
 
-static long count_open(const rs_image *last, double tol)
+/* The pixels not yet calm in SA_CALM doublings in a row. */
+static long count_open(const unsigned char *calm, long total)
 {
-    long n = 0, total = (long)last->width * last->height;
+    long n = 0;
     for (long k = 0; k < total; k++)
-        n += !(change_of(last, k) <= tol); /* NaN counts as open */
+        n += calm[k] < SA_CALM;
     return n;
 }
 
 /* One doubling: every open pixel of img rendered with r (one list, the
- * workers made once), its change into last. */
-static int level(const lr_renderer *r, double tol, rs_image *img, rs_image *last, long *renders,
-                 char *msg, size_t msg_size)
+ * workers made once), its change into last, its calm doublings counted
+ * (a NaN change is not calm). */
+static int level(const lr_renderer *r, double tol, rs_image *img, rs_image *last,
+                 unsigned char *calm, long *renders, char *msg, size_t msg_size)
 {
     long total = (long)img->width * img->height, n = 0;
     int *xy = malloc(sizeof *xy * 2 * (size_t)total);
@@ -45,7 +47,7 @@ static int level(const lr_renderer *r, double tol, rs_image *img, rs_image *last
         return -1;
     }
     for (long k = 0; k < total; k++)
-        if (!(change_of(last, k) <= tol)) {
+        if (calm[k] < SA_CALM) {
             xy[2 * n] = (int)(k % img->width);
             xy[2 * n + 1] = (int)(k / img->width);
             n++;
@@ -63,6 +65,7 @@ static int level(const lr_renderer *r, double tol, rs_image *img, rs_image *last
             last->rgb[3 * k + ch] = v - img->rgb[3 * k + ch];
             img->rgb[3 * k + ch] = v;
         }
+        calm[k] = change_of(last, (long)k) <= tol ? (unsigned char)(calm[k] + 1) : 0;
     }
     *renders += n;
     free(xy);
@@ -79,6 +82,7 @@ int sa_refine(const sa_refine_opts *o, rs_image *img, rs_image *last, sa_refine_
     lr_scene *scene = NULL;
     lr_error err;
     lr_load_opts lo;
+    unsigned char *calm; /* each pixel's calm doublings in a row */
 
     memset(st, 0, sizeof *st);
     st->wavelengths = n;
@@ -86,15 +90,25 @@ int sa_refine(const sa_refine_opts *o, rs_image *img, rs_image *last, sa_refine_
         snprintf(msg, msg_size, "sa_refine: images of different sizes");
         return -1;
     }
+    /* the doubling before the given one is not known: a pixel calm in
+     * the given one has one calm doubling */
+    calm = malloc((size_t)total + 1);
+    if (!calm) {
+        snprintf(msg, msg_size, "out of memory");
+        return -1;
+    }
+    for (long k = 0; k < total; k++)
+        calm[k] = change_of(last, k) <= o->tol; /* NaN: 0 */
     lr_load_opts_init(&lo);
     lo.image_width = img->width;
     lo.image_height = img->height;
     if (lr_scene_load(o->scene, &lo, &scene, &err) != LR_OK) {
         snprintf(msg, msg_size, "%s:%d:%d: %s", err.file, err.line, err.column, err.message);
+        free(calm);
         return -1;
     }
     for (;;) {
-        long open = count_open(last, o->tol);
+        long open = count_open(calm, total);
         if (open == 0 || 2 * n > o->wavelengths_max ||
             (double)open * 2.0 * n * per > o->budget)
             break;
@@ -111,15 +125,17 @@ int sa_refine(const sa_refine_opts *o, rs_image *img, rs_image *last, sa_refine_
         if (lr_renderer_create(scene, &ro, &r, &err) != LR_OK) {
             snprintf(msg, msg_size, "%s", err.message);
             lr_scene_free(scene);
+            free(calm);
             return -1;
         }
         double t0 = cpu_now();
         long before = st->renders;
-        int rc = level(r, o->tol, img, last, &st->renders, msg, msg_size);
+        int rc = level(r, o->tol, img, last, calm, &st->renders, msg, msg_size);
         double dt = cpu_now() - t0;
         lr_renderer_free(r);
         if (rc != 0) {
             lr_scene_free(scene);
+            free(calm);
             return -1;
         }
         st->seconds += dt;
@@ -138,7 +154,8 @@ int sa_refine(const sa_refine_opts *o, rs_image *img, rs_image *last, sa_refine_
         st->max = 0.0;
         for (long k = 0; k < total; k++)
             st->max = fmax(st->max, change_of(last, k));
-        st->left = count_open(last, o->tol);
+        st->left = count_open(calm, total);
     }
+    free(calm);
     return 0;
 }

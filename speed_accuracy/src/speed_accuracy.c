@@ -861,8 +861,8 @@ static int write_scene(const sweep *w, int s, FILE *csv, sa_points *all)
     char refined[160] = "last doubling of the wavelengths";
     if (sc->rn.refined > 0)
         snprintf(refined, sizeof refined,
-                 "%d wavelengths then pixel by pixel (%ld pixel renders; %ld pixels still "
-                 "over 1e-5); each pixel's last doubling",
+                 "%d wavelengths then pixel by pixel (%ld pixel renders; %ld pixels not "
+                 "within 1e-5 in two doublings); each pixel's last doubling",
                  sc->rn.whole, sc->rn.refined, sc->rn.left);
     sa_point_init(&p, "reference", "polarized", sc->rn.wavelengths, sc->rn.depth,
                   sc->rn.cutoff);
