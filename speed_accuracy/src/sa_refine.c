@@ -86,19 +86,23 @@ int sa_refine(const sa_refine_opts *o, rs_image *img, rs_image *last, sa_refine_
 
     memset(st, 0, sizeof *st);
     st->wavelengths = n;
-    if (!img->rgb || !last->rgb || last->width != img->width || last->height != img->height) {
+    if (!img->rgb || !last->rgb || last->width != img->width || last->height != img->height ||
+        (o->before && (!o->before->rgb || o->before->width != img->width ||
+                       o->before->height != img->height))) {
         snprintf(msg, msg_size, "sa_refine: images of different sizes");
         return -1;
     }
-    /* the doubling before the given one is not known: a pixel calm in
-     * the given one has one calm doubling */
+    /* a pixel calm in the given doubling has one calm doubling, two
+     * where it was calm in the one before too */
     calm = malloc((size_t)total + 1);
     if (!calm) {
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
     for (long k = 0; k < total; k++)
-        calm[k] = change_of(last, k) <= o->tol; /* NaN: 0 */
+        calm[k] = (unsigned char)(change_of(last, k) <= o->tol
+                                      ? 1 + (o->before && change_of(o->before, k) <= o->tol)
+                                      : 0); /* NaN: 0 */
     lr_load_opts_init(&lo);
     lo.image_width = img->width;
     lo.image_height = img->height;

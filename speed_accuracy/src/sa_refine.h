@@ -14,8 +14,8 @@
  * through crossed_polarizers' lens changed by 1e-5 from 2048 to 4096
  * wavelengths and by 0.016 from 4096 to 8192 (then 1e-6 to 16384); the
  * reference kept it at 4096, 0.016 off, and auto's render at 16384 was
- * counted wrong there.  The doubling before the given one is unknown: a
- * pixel calm in the given one starts with one calm doubling.  Each pixel keeps its own last change; their RMS
+ * counted wrong there.  A pixel starts with the calm doublings of the
+ * given change and, where given, the change before it.  Each pixel keeps its own last change; their RMS
  * over the image stands for the reference's wavelength error as the
  * whole image's last change did.  Every pixel is lr_render_region's,
  * bit for bit what a whole render at its wavelength count gives. */
@@ -40,6 +40,8 @@ typedef struct sa_refine_opts {
     double budget;      /* no doubling predicted to take longer (CPU s) */
     double s_per_pixel_wl; /* a first guess of a pixel's cost per
                               wavelength (CPU s) */
+    const rs_image *before; /* each pixel's change in the doubling before
+                               the last (NULL: not known, as if not calm) */
 } sa_refine_opts;
 
 typedef struct sa_refine_stats {

@@ -382,9 +382,10 @@ static int image_diff(rs_image *out, const rs_image *a, const rs_image *b)
 
 /* Past the whole image's doublings: the pixels still changing, pixel by
  * pixel (sa_refine.h), from `last`, each pixel's change in the last
- * doubling measured. */
+ * doubling measured, and `before` (NULL: not measured), its change in
+ * the doubling before. */
 static int refine_reference(scene_ctx *sc, int n, int d, double c, double seconds,
-                            rs_image *last)
+                            rs_image *last, const rs_image *before)
 {
     sa_refine_opts ro;
     sa_refine_stats st;
@@ -398,6 +399,7 @@ static int refine_reference(scene_ctx *sc, int n, int d, double c, double second
     ro.tol = REF_TOL;
     ro.budget = sc->o->reference_seconds;
     ro.s_per_pixel_wl = seconds / (pixels * n);
+    ro.before = before;
     if (sa_refine(&ro, &sc->ref, last, &st, msg, sizeof msg) != 0) {
         say("%s: %s", sc->name, msg);
         return -1;
@@ -421,6 +423,8 @@ static int make_reference(scene_ctx *sc)
 {
     sa_point p;
     rs_image base, prev = {0, 0, NULL}, last = {0, 0, NULL};
+    rs_image prev2 = {0, 0, NULL}, before = {0, 0, NULL}; /* the doubling before */
+    double before_max = INFINITY;
     int n = REF_WAVELENGTHS0, d = REF_DEPTH0;
     double c = REF_CUTOFF0, seconds;
 
@@ -439,7 +443,7 @@ static int make_reference(scene_ctx *sc)
             rc = render(sc, &p, 1, 0.0, &half) != 0 || image_diff(&last, &sc->ref, &half) != 0
                      ? -1
                      : refine_reference(sc, sc->rn.wavelengths, sc->rn.depth, sc->rn.cutoff,
-                                        2.0 * p.seconds, &last);
+                                        2.0 * p.seconds, &last, NULL);
             rs_image_free(&half);
             rs_image_free(&last);
             if (rc != 0)
@@ -515,15 +519,17 @@ static int make_reference(scene_ctx *sc)
     }
     while (!sc->rn.dn_cheap && 2 * n <= sc->o->max_wavelengths &&
            2.5 * seconds <= sc->o->reference_seconds) {
-        if (image_copy(&prev, &base) != 0 ||
+        if ((prev.rgb && image_copy(&prev2, &prev) != 0) || image_copy(&prev, &base) != 0 ||
             ref_step(sc, 2 * n, d, c, &base, &sc->rn.dn_max, &sc->rn.dn_rmse, &seconds) != 0)
             return -1;
         fprintf(stderr,
                 "speed_accuracy: %s: wavelengths %d -> %d: max change %.3g, rmse %.3g (%.3g s)\n",
                 sc->name, n, 2 * n, sc->rn.dn_max, sc->rn.dn_rmse, seconds);
         n *= 2;
-        if (sc->rn.dn_max <= REF_TOL)
+        /* two doublings in a row within the tolerance (sa_refine.h) */
+        if (sc->rn.dn_max <= REF_TOL && before_max <= REF_TOL)
             break;
+        before_max = sc->rn.dn_max;
     }
     sc->ref = base;
     sc->rn.wavelengths = n;
@@ -533,13 +539,19 @@ static int make_reference(scene_ctx *sc)
     sc->rn.refined = sc->rn.left = 0;
     if (!sc->rn.dn_cheap && prev.rgb && image_diff(&last, &base, &prev) != 0)
         return -1;
+    if (!sc->rn.dn_cheap && prev2.rgb && image_diff(&before, &prev, &prev2) != 0)
+        return -1;
     rs_image_free(&prev);
-    if (sc->rn.dn_max > REF_TOL && last.rgb && 2 * n <= sc->o->max_wavelengths &&
-        refine_reference(sc, n, d, c, seconds, &last) != 0) {
+    rs_image_free(&prev2);
+    if (!(sc->rn.dn_max <= REF_TOL && before_max <= REF_TOL) && last.rgb &&
+        2 * n <= sc->o->max_wavelengths &&
+        refine_reference(sc, n, d, c, seconds, &last, before.rgb ? &before : NULL) != 0) {
         rs_image_free(&last);
+        rs_image_free(&before);
         return -1;
     }
     rs_image_free(&last);
+    rs_image_free(&before);
     sc->rn.u = sc->rn.dn_rmse + sc->rn.dd_rmse + sc->rn.dc_rmse;
     return 0; /* saved by the process that gathers (reference_done) */
 }

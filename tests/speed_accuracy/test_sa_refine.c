@@ -10,7 +10,8 @@
  * R_{L/4} are both within tol, else R64; the statistics are the pixels
  * rendered per doubling (the open pixels at 8, 16 and 32), the most
  * wavelengths any pixel reached, the RMS of each pixel's last change and
- * the pixels still open.  With no budget nothing is rendered; images
+ * the pixels still open.  Given the change of the doubling before
+ * (R4 - R2), a pixel calm in both starts converged.  With no budget nothing is rendered; images
  * of different sizes are refused. */
 #define _POSIX_C_SOURCE 200809L
 
@@ -147,6 +148,41 @@ int main(void)
           st.renders, renders, st.wavelengths, 4 << most, st.left, left);
     /* the same float changes summed in the same order: 0 difference measured */
     CHECK_REL(st.rmse, sqrt(sum / (3.0 * W * H)), 1e-12, "the RMS of each pixel's last change");
+
+    /* with the change before (R4 - R2) given: a pixel calm in both
+     * starts converged, one calm in R8 - R4 alone starts with one */
+    {
+        static float R2[3 * W * H];
+        rs_image before = {0, 0, NULL};
+        int want2[W * H];
+        long renders2 = 0;
+        CHECK(render(scene, 2, R2) == 0 && rs_image_create(&before, W, H) == 0,
+              "render at 2 wavelengths");
+        for (int k = 0; before.rgb && k < 3 * W * H; k++)
+            before.rgb[k] = R[0][k] - R2[k];
+        for (int k = 0; k < W * H; k++) {
+            int l = 1, calm = open_between(R[0], R[1], k) ? 0 : 1 + !open_between(R2, R[0], k);
+            while (l < LEVELS - 1 && calm < 2) {
+                renders2++;
+                l++;
+                calm = open_between(R[l - 1], R[l], k) ? 0 : calm + 1;
+            }
+            want2[k] = l;
+        }
+        memcpy(img.rgb, R[1], sizeof R[1]);
+        for (int k = 0; k < 3 * W * H; k++)
+            last.rgb[k] = R[1][k] - R[0][k];
+        o.before = &before;
+        CHECK(sa_refine(&o, &img, &last, &st, msg, sizeof msg) == 0, "sa_refine: %s", msg);
+        int same2 = 1;
+        for (int k = 0; same2 && k < W * H; k++)
+            same2 = memcmp(&img.rgb[3 * k], &R[want2[k]][3 * k], 3 * sizeof(float)) == 0;
+        CHECK(same2 && st.renders == renders2 && renders2 < renders,
+              "with the doubling before: every pixel at its count, %ld renders (want %ld, "
+              "fewer than %ld)", st.renders, renders2, renders);
+        o.before = NULL;
+        rs_image_free(&before);
+    }
 
     /* no budget: nothing rendered, nothing changed */
     memcpy(img.rgb, R[1], sizeof R[1]);
