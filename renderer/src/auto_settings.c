@@ -234,7 +234,7 @@ static int render_pixels(const rs_scene *s, const rs_render_opts *opts, const in
     }
     for (int g = 0; g < ng && rc == 0; g++) {
         for (size_t m = 0; m < n[g] && rc == 0; m++, k++) {
-            rs_work pb = {0, 0, 0, 0}, pa;
+            rs_work pb, pa;
             unsigned long long s0 = rs_worker_splits(w);
             rs_worker_work(w, &pb);
             rs_integrator_pixel(it, w, px[2 * k], px[2 * k + 1], &out[k]);
@@ -345,7 +345,8 @@ static int pilot_mark(const rs_scene *s, const rs_render_opts *base, int polariz
     f.wavelengths = 1;
     {
         double gc;
-        if (render_pixels(s, &f, px, &n, 1, NULL, 0.0, c, &gc, NULL, NULL, NULL, spent, msg, msg_size) != 0)
+        if (render_pixels(s, &f, px, &n, 1, NULL, 0.0, c, &gc, NULL, NULL, NULL, spent, msg,
+                          msg_size) != 0)
             goto out;
     }
     for (int pass = 0; pass < (polarized ? 1 : 2); pass++) {
@@ -481,8 +482,6 @@ static void shot_free(shot *s)
     s->pc = NULL;
     s->split = NULL;
 }
-
-static void shot_free(shot *s);
 
 /* cap > 0: a render whose cost over the image would pass it stops and
  * returns 1, *out left empty. */

@@ -427,7 +427,7 @@ static int make_reference(scene_ctx *sc)
     rs_image base, prev = {0, 0, NULL}, last = {0, 0, NULL};
     rs_image prev2 = {0, 0, NULL}, before = {0, 0, NULL}; /* the doubling before */
     double before_max = INFINITY;
-    int n = REF_WAVELENGTHS0, d = REF_DEPTH0;
+    int n = REF_WAVELENGTHS0, d = REF_DEPTH0, settled = 0; /* two calm doublings */
     double c = REF_CUTOFF0, seconds;
 
     if (sc->o->reuse && load_reference(sc) == 0) {
@@ -529,7 +529,8 @@ static int make_reference(scene_ctx *sc)
                 sc->name, n, 2 * n, sc->rn.dn_max, sc->rn.dn_rmse, seconds);
         n *= 2;
         /* two doublings in a row within the tolerance (sa_refine.h) */
-        if (sc->rn.dn_max <= REF_TOL && before_max <= REF_TOL)
+        settled = sc->rn.dn_max <= REF_TOL && before_max <= REF_TOL;
+        if (settled)
             break;
         before_max = sc->rn.dn_max;
     }
@@ -545,7 +546,7 @@ static int make_reference(scene_ctx *sc)
         return -1;
     rs_image_free(&prev);
     rs_image_free(&prev2);
-    if (!(sc->rn.dn_max <= REF_TOL && before_max <= REF_TOL) && last.rgb &&
+    if (!settled && last.rgb &&
         2 * n <= sc->o->max_wavelengths &&
         refine_reference(sc, n, d, c, seconds, &last, before.rgb ? &before : NULL) != 0) {
         rs_image_free(&last);
