@@ -27,18 +27,15 @@ typedef struct lp__bw_way {
 } lp__bw_way;
 
 struct lp_backward {
+    /* The scalars first: lp_backward_create clears the builder up to
+     * node[] and no further (the arrays below are written by every build
+     * before they are read), so a new scalar belongs here. */
     const lp_lens *lens;
     lp_trace_args args;
     lp__optics optics;
     lp_vec3 view_dir;              /* local e_0 */
     int n_nodes;
-    lp__bw_node node[LP_MAX_DEPTH + 1]; /* node[1..n_nodes] */
     size_t n_queries;
-    lp_query query[LP_MAX_DEPTH];
-    lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
-    /* per query: 1 its ray leaves the lens for sure, 0 not for sure, -1
-     * not known yet (lp_backward_query_leaves works it out) */
-    signed char leaves[LP_MAX_DEPTH];
     lp__exit exit;                   /* where gathered light leaves */
     int rim_depth;
     unsigned warnings;
@@ -46,6 +43,15 @@ struct lp_backward {
     /* The gathers' ways (trace_backward.c), set up once by a polarized
      * build: ways is 0 until then (cleared as a build starts) */
     int ways;
+    /* lp_backward_build_many's mark: whether this builder was met
+     * already in its list (found in two passes, not by comparing pairs) */
+    unsigned char listed;
+    lp__bw_node node[LP_MAX_DEPTH + 1]; /* node[1..n_nodes] */
+    lp_query query[LP_MAX_DEPTH];
+    lp_vec3 query_dir[LP_MAX_DEPTH]; /* local */
+    /* per query: 1 its ray leaves the lens for sure, 0 not for sure, -1
+     * not known yet (lp_backward_query_leaves works it out) */
+    signed char leaves[LP_MAX_DEPTH];
     lp__bw_way light[LP_MAX_DEPTH]; /* light[j]: node j, light arriving from inside */
     lp__bw_way entry[LP_MAX_DEPTH]; /* entry[q]: where query q's light enters */
     /* per query, how a gather may take its rays in lanes
@@ -63,9 +69,6 @@ struct lp_backward {
     double pform[LP_MAX_DEPTH][3];
     lp_vec3 pform_s[LP_MAX_DEPTH], pform_p[LP_MAX_DEPTH];
     signed char pform_ok[LP_MAX_DEPTH];
-    /* lp_backward_build_many's mark: whether this builder was met
-     * already in its list (found in two passes, not by comparing pairs) */
-    unsigned char listed;
 };
 
 /* Add the query of the given depth, kind and surface leaving node

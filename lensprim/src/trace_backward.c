@@ -30,25 +30,18 @@ lp_status lp_backward_create(lp_backward **out, lp_error *err)
 {
     if (!out)
         return lp__fail(err, LP_ERROR_INVALID_ARGUMENT, "lp_backward_create: NULL argument");
-    /* Only the scalars are cleared.  The per-node and per-query arrays,
-     * all but a few hundred bytes of the builder's 55 kB, are written by
-     * every build before anything reads them (a node as the chain reaches
-     * it, a query's entries as it is added, the ways when a build sets
-     * them up): zeroing them paid for pages a shallow build never
-     * touches, each time a builder was made (--mode auto's probe makes a
-     * worker per render: 30 % of its time on desk_lamp.scene at
-     * 320 x 240). */
+    /* Only the scalars, which come first (backward.h), are cleared.  The
+     * per-node and per-query arrays after them, all but a few hundred
+     * bytes of the builder's 55 kB, are written by every build before
+     * anything reads them (a node as the chain reaches it, a query's
+     * entries as it is added, the ways when a build sets them up):
+     * zeroing them paid for pages a shallow build never touches, each
+     * time a builder was made (--mode auto's probe makes a worker per
+     * render: 30 % of its time on desk_lamp.scene at 320 x 240). */
     lp_backward *bw = malloc(sizeof *bw);
     if (!bw)
         return lp__fail(err, LP_ERROR_NO_MEMORY, "out of memory creating a backward tracer");
     memset(bw, 0, offsetof(lp_backward, node));
-    bw->n_queries = 0;
-    memset(&bw->exit, 0, sizeof bw->exit);
-    bw->rim_depth = 0;
-    bw->warnings = 0;
-    bw->xb = NULL;
-    bw->ways = 0;
-    bw->listed = 0;
     *out = bw;
     lp__ok(err);
     return LP_OK;
