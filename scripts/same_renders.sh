@@ -5,19 +5,25 @@
 # and compares the float renders (--pfm): a file equal byte for byte is
 # "identical"; otherwise the largest absolute difference of a sample is
 # printed.  For a speed change that must not change results.
-#   sh scripts/same_renders.sh OLD_BIN NEW_BIN [WIDTH HEIGHT]
+#   sh scripts/same_renders.sh OLD_BIN NEW_BIN [WIDTH HEIGHT [WAVELENGTHS]]
+# WAVELENGTHS (default: lensrender's) for the spectral models: e.g. 1024
+# to take the paths a packet of many wavelengths takes at a lens.
 # OLD_BIN and NEW_BIN are directories holding lensrender (e.g. a build of
 # the commit before, and build/bin).  Exit status 0 when every render is
 # identical, 1 when one differs, 2 on bad arguments or a failed render.
 set -eu
-if [ $# -ne 2 ] && [ $# -ne 4 ]; then
-    echo "usage: sh scripts/same_renders.sh OLD_BIN NEW_BIN [WIDTH HEIGHT]" >&2
+if [ $# -ne 2 ] && [ $# -ne 4 ] && [ $# -ne 5 ]; then
+    echo "usage: sh scripts/same_renders.sh OLD_BIN NEW_BIN [WIDTH HEIGHT [WAVELENGTHS]]" >&2
     exit 2
 fi
 old=$1
 new=$2
 W=${3:-64}
 H=${4:-48}
+N=${5:-}
+case $N in
+'' | *[!0-9]*) [ -z "$N" ] || { echo "same_renders: WAVELENGTHS must be a count" >&2; exit 2; } ;;
+esac
 for b in "$old" "$new"; do
     [ -x "$b/lensrender" ] || { echo "same_renders: no lensrender in $b" >&2; exit 2; }
 done
@@ -45,10 +51,12 @@ for s in scenes/*.scene scenes/*/*.scene; do
     n=$(basename "$s" .scene)
     for m in polarized fresnel schlick rgb; do
         for d in "" --no-dispersion; do
+            wl=
+            [ -z "$N" ] || [ "$m" = rgb ] || wl="--wavelengths $N"
             for side in old new; do
                 eval "bin=\$$side"
-                # shellcheck disable=SC2086 # $d is empty or one word
-                if ! "$bin/lensrender" "$s" --width "$W" --height "$H" --mode "$m" $d \
+                # shellcheck disable=SC2086 # $d is empty or one word, $wl two
+                if ! "$bin/lensrender" "$s" --width "$W" --height "$H" --mode "$m" $d $wl \
                         --quiet -o "$tmp/$side.png" --pfm "$tmp/$side.pfm" 2>"$tmp/err"; then
                     echo "same_renders: $bin/lensrender $s --mode $m $d failed:" >&2
                     cat "$tmp/err" >&2
@@ -65,5 +73,6 @@ for s in scenes/*.scene scenes/*/*.scene; do
         done
     done
 done
-printf '%d renders identical, %d differ (%dx%d)\n' "$same" "$differ" "$W" "$H"
+printf '%d renders identical, %d differ (%dx%d%s)\n' "$same" "$differ" "$W" "$H" \
+    "${N:+, $N wavelengths}"
 [ "$differ" -eq 0 ]

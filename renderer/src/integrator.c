@@ -52,6 +52,7 @@
 
 #define RS_MAX_FRAMES 400
 #define RS_PI 3.14159265358979323846
+#define BUILD_CHUNK 64 /* a lens hit's sub-packets built at once (build_chunk) */
 
 enum { BAND_CONTINUUM, BAND_LINE, BAND_RGB };
 
@@ -152,9 +153,15 @@ typedef struct frame {
     lp_backward *bw; /* the build of the sub-packet being traced: one of bws */
     /* A lens hit's sub-packets (lens_builds): sub-packet s has the lanes
      * sub_lane[sub_at[s] .. sub_at[s + 1]), at those positions sub_pos of
-     * the packet, its build in bws[s] where sub_ok[s] */
+     * the packet; they are built BUILD_CHUNK at a time (build_chunk), the
+     * sub-packets [built_at, built_end) in bws[0 ..), sub-packet s's build
+     * in bws[s - built_at] where sub_ok[s] */
     lp_backward **bws;
     int n_bws;       /* builders created */
+    int built_at, built_end;
+    const lp_lens *b_lens; /* what the builds are of */
+    lp_vec3 b_o, b_d;
+    lp_trace_args b_args;
     int *sub_at, *sub_lane, *sub_pos;
     double *sub_lambda;
     unsigned char *sub_ok;
@@ -1239,15 +1246,44 @@ static int every_lane_alone(int ns, int n, const rs_object *ob)
     return ns == n && n > 1 && !ob->u.lens.desc.uniaxial;
 }
 
+/* The builds of sub-packets [from, from + BUILD_CHUNK) of the frame's
+ * lens hit (lens_builds) into bws[0 ..): at a dispersive lens one
+ * lp_backward_build_many for their wavelengths, each build exactly
+ * lp_backward_build's.  A chunk, not all of them: a hit of 1024
+ * wavelengths alone would hold 1024 builds, megabytes that no cache
+ * keeps (default.scene at 128 x 96, depth 8, cut-off 1e-3: 512
+ * wavelengths took 2.7 times 256's time, 1024 3.1 times 512's).
+ * Returns -1 when out of memory. */
+static int build_chunk(frame *fr, int from)
+{
+    int to = fr->n_sub - from > BUILD_CHUNK ? from + BUILD_CHUNK : fr->n_sub, nb = to - from;
+    for (int s = fr->n_bws; s < nb; s++) {
+        if (lp_backward_create(&fr->bws[s], NULL) != LP_OK)
+            return -1;
+        fr->n_bws++;
+    }
+    int all = nb > 1 && lp_backward_build_many(fr->bws, (size_t)nb, fr->b_lens, fr->b_o, fr->b_d,
+                                               fr->sub_lambda + from, &fr->b_args,
+                                               NULL) == LP_OK;
+    /* else each alone, to know which build fails (a sub-packet whose
+     * build fails sees nothing) */
+    for (int s = 0; s < nb; s++)
+        fr->sub_ok[from + s] = all || lp_backward_build(fr->bws[s], fr->b_lens, fr->b_o, fr->b_d,
+                                                        fr->sub_lambda[from + s], &fr->b_args,
+                                                        NULL) == LP_OK;
+    fr->built_at = from;
+    fr->built_end = to;
+    return 0;
+}
+
 /* A lens hit of the packet lane[0..n) at lens `object` along (o, d): its
  * sub-packets (lanes of equal optics there, rs_packet_split, in the
- * frame's sub_ arrays) and their backward builds, made at once -- at a
- * dispersive lens, one lp_backward_build_many for the sub-packets'
- * wavelengths, each build exactly lp_backward_build's.  power: the
- * gathers of a hit whose every lane is alone will want their power only
- * (camera_power), so those builds make their queries' power forms
- * (LP_BACKWARD_POWER).  lens_next then hands them out in order.  Returns
- * -1 when out of memory. */
+ * frame's sub_ arrays) and the builds of the first BUILD_CHUNK of them
+ * (build_chunk).  power: the gathers of a hit whose every lane is alone
+ * will want their power only (camera_power), so those builds make their
+ * queries' power forms (LP_BACKWARD_POWER).  lens_next then hands them
+ * out in order, building the next chunk as it comes to it.  Returns -1
+ * when out of memory. */
 static int lens_builds(rs_worker *w, frame *fr, const rs_object *ob, int object,
                        const int *lane, int n, lp_vec3 o, lp_vec3 d, const lp_trace_args *a,
                        int power)
@@ -1263,39 +1299,41 @@ static int lens_builds(rs_worker *w, frame *fr, const rs_object *ob, int object,
         a = &pa;
     }
     for (int s = 0; s < ns; s++) {
-        if (s == fr->n_bws) {
-            if (lp_backward_create(&fr->bws[s], NULL) != LP_OK)
-                return -1;
-            fr->n_bws++;
-        }
         for (int k = fr->sub_at[s]; k < fr->sub_at[s + 1]; k++)
             fr->sub_lane[k] = lane[fr->sub_pos[k]];
         fr->sub_lambda[s] = it->lanes[fr->sub_lane[fr->sub_at[s]]].lambda;
     }
     fr->n_sub = ns;
     fr->sub_next = 0;
-    int all = ns > 1 && lp_backward_build_many(fr->bws, (size_t)ns, ob->lens, o, d,
-                                               fr->sub_lambda, a, NULL) == LP_OK;
-    /* else each alone, to know which build fails (a sub-packet whose
-     * build fails sees nothing) */
-    for (int s = 0; s < ns; s++)
-        fr->sub_ok[s] = all || lp_backward_build(fr->bws[s], ob->lens, o, d, fr->sub_lambda[s],
-                                                 a, NULL) == LP_OK;
-    return 0;
+    fr->b_lens = ob->lens;
+    fr->b_o = o;
+    fr->b_d = d;
+    fr->b_args = *a;
+    return build_chunk(fr, 0);
 }
 
 /* The next sub-packet of lens_builds whose build succeeded: its lanes in
  * fr->lane, their positions in the packet in fr->pos, its build in
- * fr->bw.  Returns how many lanes, 0 when no sub-packet is left. */
-static int lens_next(frame *fr)
+ * fr->bw; at the end of a chunk it builds the next (the builds before it
+ * are then gone), or with hold returns -1 for the caller to call
+ * build_chunk once done with them.  Returns how many lanes, 0 when no
+ * sub-packet is left (or, out of memory, none can be built: the hit
+ * stops there). */
+static int lens_next(frame *fr, int hold)
 {
     while (fr->sub_next < fr->n_sub) {
+        if (fr->sub_next == fr->built_end) {
+            if (hold)
+                return -1;
+            if (build_chunk(fr, fr->sub_next) != 0)
+                return 0;
+        }
         int s = fr->sub_next++, at = fr->sub_at[s], m = fr->sub_at[s + 1] - at;
         if (!fr->sub_ok[s])
             continue;
         memcpy(fr->lane, fr->sub_lane + at, (size_t)m * sizeof *fr->lane);
         memcpy(fr->pos, fr->sub_pos + at, (size_t)m * sizeof *fr->pos);
-        fr->bw = fr->bws[s];
+        fr->bw = fr->bws[s - fr->built_at];
         return m;
     }
     return 0;
@@ -1380,7 +1418,7 @@ static void trace_scalar_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp
         fr->qm.valid = 0;
         if (lens_builds(w, fr, ob, h.object, lane, n, o, d, &a, 0) != 0)
             return;
-        while ((m = lens_next(fr)) > 0) {
+        while ((m = lens_next(fr, 0)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             w->work.builds += 1.0;
@@ -1933,54 +1971,15 @@ static void gather_power_all(rs_worker *w, frame *fr, size_t nr)
         w->pixel_power[fr->gm_lane[k]] += fr->gm_power[k];
 }
 
-/* The lens branch of trace_pol_hit where every sub-packet of the hit h
- * (of lens_builds) is one lane and the lens is not a crystal: every
- * query of every sub-packet traced, in order (for each sub-packet, each
- * of its queries, as the loop of trace_pol_hit traces them: the wavelets
- * and the counters come in that order), each into its own bundle; then
- * all of them gathered in one lp_backward_gather_many, which carries the
- * rays of many wavelengths side by side, and the outputs appended to out
- * in the same order, their optical paths then counted from the ray's
- * origin (shift_op, by h->t) -- or, at the camera ray's own hit where
- * nothing interferes (camera_power: builds made for power alone), their
- * power alone added to the pixel's lanes (gather_power_all), nothing
- * appended to out.  A gather that fails gives nothing, as there; out of
- * memory, the branch stops where it is, as there. */
-static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, double weight,
-                       int f, bundle *out, size_t start)
+/* The gathers gm_*[0 .. nr) of gather_all, made: their power added to
+ * the pixel's lanes (power: camera_power), or their rays appended to out
+ * in order.  Returns -1 when out of memory. */
+static int gather_flush(rs_worker *w, frame *fr, size_t nr, int power, bundle *out)
 {
-    const rs_scene *sc = w->it->scene;
-    size_t nr = 0;
-    int m, power = camera_power(w->it, f);
-    while ((m = lens_next(fr)) > 0) { /* m is 1 */
-        size_t nq = lp_backward_query_count(fr->bw);
-        const lp_query *q = lp_backward_queries(fr->bw);
-        ++w->splits; /* a lens hit's id, as trace_pol_hit counts them */
-        w->work.builds += 1.0;
-        if (gather_room(fr, nr + nq) != 0)
-            return;
-        for (size_t j = 0; j < nq; j++) {
-            bundle *c = &fr->kids[nr];
-            bundle_clear(c);
-            trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir,
-                          query_hit(sc, fr, q, j, lens_object(sc, h)), level + q[j].depth,
-                          weight * q[j].bound, f + 1, c);
-            if (c->n == 0)
-                continue;
-            if (!power) /* a ray's power alone costs about a multiplication */
-                w->work.gathered += (double)c->n;
-            fr->gm_bw[nr] = fr->bw;
-            fr->gm_q[nr] = j;
-            fr->gm_b[nr] = c->r;
-            fr->gm_n[nr] = c->n;
-            fr->gm_lane[nr] = fr->lane[0];
-            nr++;
-        }
-    }
     lp_result_clear(&fr->res);
     if (power) {
         gather_power_all(w, fr, nr);
-        return;
+        return 0;
     }
     /* a failed gather stops the call: its outputs are dropped, and the
      * gathers after it made by another (it is the last whose start is set) */
@@ -2009,10 +2008,67 @@ static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, doub
         for (size_t t = fr->gm_start[k]; t < end; t++) {
             lp_ray *r = bundle_push(out, fr->gm_lane[k]);
             if (!r)
-                return;
+                return -1;
             *r = fr->res.rays[t].ray;
         }
     }
+    return 0;
+}
+
+/* The lens branch of trace_pol_hit where every sub-packet of the hit h
+ * (of lens_builds) is one lane and the lens is not a crystal: every
+ * query of every sub-packet traced, in order (for each sub-packet, each
+ * of its queries, as the loop of trace_pol_hit traces them: the wavelets
+ * and the counters come in that order), each into its own bundle; then
+ * those of each chunk of builds (build_chunk) gathered in one
+ * lp_backward_gather_many, which carries the rays of many wavelengths
+ * side by side, and the outputs appended to out in the same order, their
+ * optical paths then counted from the ray's origin (shift_op, by h->t)
+ * -- or, at the camera ray's own hit where nothing interferes
+ * (camera_power: builds made for power alone), their power alone added
+ * to the pixel's lanes (gather_power_all), nothing appended to out.  A
+ * gather's outputs are lp_backward_gather's whatever the chunk.  A
+ * gather that fails gives nothing, as there; out of memory, the branch
+ * stops where it is, as there. */
+static void gather_all(rs_worker *w, frame *fr, const rs_hit *h, int level, double weight,
+                       int f, bundle *out, size_t start)
+{
+    const rs_scene *sc = w->it->scene;
+    size_t nr = 0;
+    int m, power = camera_power(w->it, f);
+    while ((m = lens_next(fr, 1)) != 0) { /* m is 1, or -1 at a chunk's end */
+        if (m < 0) { /* the chunk's gathers, before its builds go */
+            if (gather_flush(w, fr, nr, power, out) != 0 || build_chunk(fr, fr->sub_next) != 0)
+                return;
+            nr = 0;
+            continue;
+        }
+        size_t nq = lp_backward_query_count(fr->bw);
+        const lp_query *q = lp_backward_queries(fr->bw);
+        ++w->splits; /* a lens hit's id, as trace_pol_hit counts them */
+        w->work.builds += 1.0;
+        if (gather_room(fr, nr + nq) != 0)
+            return;
+        for (size_t j = 0; j < nq; j++) {
+            bundle *c = &fr->kids[nr];
+            bundle_clear(c);
+            trace_pol_hit(w, fr->lane, m, q[j].origin, q[j].dir,
+                          query_hit(sc, fr, q, j, lens_object(sc, h)), level + q[j].depth,
+                          weight * q[j].bound, f + 1, c);
+            if (c->n == 0)
+                continue;
+            if (!power) /* a ray's power alone costs about a multiplication */
+                w->work.gathered += (double)c->n;
+            fr->gm_bw[nr] = fr->bw;
+            fr->gm_q[nr] = j;
+            fr->gm_b[nr] = c->r;
+            fr->gm_n[nr] = c->n;
+            fr->gm_lane[nr] = fr->lane[0];
+            nr++;
+        }
+    }
+    if (gather_flush(w, fr, nr, power, out) != 0 || power)
+        return;
     shift_op(out, start, h->t);
 }
 
@@ -2072,7 +2128,7 @@ static void trace_pol_hit(rs_worker *w, const int *lane, int n, lp_vec3 o, lp_ve
             gather_all(w, fr, &h, level, weight, f, out, start);
             return;
         }
-        while ((m = lens_next(fr)) > 0) {
+        while ((m = lens_next(fr, 0)) > 0) {
             size_t nq = lp_backward_query_count(fr->bw);
             const lp_query *q = lp_backward_queries(fr->bw);
             uint64_t hit_id = ++w->splits;
