@@ -22,7 +22,7 @@ W=${3:-64}
 H=${4:-48}
 N=${5:-}
 case $N in
-'' | *[!0-9]*) [ -z "$N" ] || { echo "same_renders: WAVELENGTHS must be a count" >&2; exit 2; } ;;
+*[!0-9]*) echo "same_renders: WAVELENGTHS must be a count" >&2; exit 2 ;;
 esac
 for b in "$old" "$new"; do
     [ -x "$b/lensrender" ] || { echo "same_renders: no lensrender in $b" >&2; exit 2; }
@@ -58,7 +58,7 @@ for s in scenes/*.scene scenes/*/*.scene; do
                 # shellcheck disable=SC2086 # $d is empty or one word, $wl two
                 if ! "$bin/lensrender" "$s" --width "$W" --height "$H" --mode "$m" $d $wl \
                         --quiet -o "$tmp/$side.png" --pfm "$tmp/$side.pfm" 2>"$tmp/err"; then
-                    echo "same_renders: $bin/lensrender $s --mode $m $d failed:" >&2
+                    echo "same_renders: $bin/lensrender $s --mode $m $d $wl failed:" >&2
                     cat "$tmp/err" >&2
                     exit 2
                 fi
