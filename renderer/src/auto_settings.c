@@ -168,24 +168,53 @@ static int sees_lens(const rs_scene *s, lp_vec3 o, lp_vec3 d)
  * and changes no pixel's answer.  boxed 0: some lens has no box (or the
  * scene no tree), so every pixel is intersected. */
 typedef struct lens_boxes {
-    int *lens; /* the lenses' object indices */
+    int *lens;  /* the lenses' object indices */
+    int *rect;  /* 4 per lens: the pixels whose ray may meet its box
+                   (rs_camera_box_pixels) */
     size_t n;
     int boxed;
 } lens_boxes;
 
-static int lens_boxes_init(const rs_scene *s, lens_boxes *lb)
+static int lens_boxes_init(const rs_scene *s, const rs_view *view, int width, int height,
+                           lens_boxes *lb)
 {
     lb->n = 0;
     lb->boxed = s->bvh && rs_bvh_object_count(s->bvh) == s->n_objects;
     lb->lens = malloc(sizeof *lb->lens * (s->n_objects + 1));
-    if (!lb->lens)
+    lb->rect = malloc(sizeof *lb->rect * 4 * (s->n_objects + 1));
+    if (!lb->lens || !lb->rect)
         return -1;
     for (size_t i = 0; i < s->n_objects; i++) {
+        lp_vec3 lo, hi;
+        int *r = lb->rect + 4 * lb->n;
         if (s->objects[i].type != RS_OBJ_LENS)
             continue;
         lb->lens[lb->n++] = (int)i;
         if (!rs_bvh_culls(s->bvh, (int)i))
             lb->boxed = 0;
+        if (!rs_object_bounds(&s->objects[i], &lo, &hi) ||
+            !rs_camera_box_pixels(view, width, height, lo, hi, r))
+            r[0] = 0, r[1] = width, r[2] = 0, r[3] = height;
+    }
+    return 0;
+}
+
+static void lens_boxes_free(lens_boxes *lb)
+{
+    free(lb->lens);
+    free(lb->rect);
+    lb->lens = NULL;
+    lb->rect = NULL;
+}
+
+/* Might pixel (i, j) see a lens?  0 only when no lens's box projects onto
+ * it: its camera ray is not even made. */
+static int may_project_lens(const lens_boxes *lb, int i, int j)
+{
+    for (size_t k = 0; k < lb->n; k++) {
+        const int *r = lb->rect + 4 * k;
+        if (i >= r[0] && i < r[1] && j >= r[2] && j < r[3])
+            return 1;
     }
     return 0;
 }
@@ -383,32 +412,35 @@ static int probe_pick(const rs_scene *s, const rs_render_opts *base, int polariz
         return -1;
     unsigned char *group = malloc((size_t)total);
     unsigned char *mark = calloc((size_t)total, 1);
-    lens_boxes lb = {NULL, 0, 0};
-    if (!group || !mark || lens_boxes_init(s, &lb) != 0) {
+    lens_boxes lb = {NULL, NULL, 0, 0};
+    if (!group || !mark || lens_boxes_init(s, &view, width, height, &lb) != 0) {
         free(group);
         free(mark);
-        free(lb.lens);
+        lens_boxes_free(&lb);
         snprintf(msg, msg_size, "out of memory");
         return -1;
     }
     if (pilot_mark(s, base, polarized, step, mark, spent, msg, msg_size) != 0) {
         free(group);
         free(mark);
-        free(lb.lens);
+        lens_boxes_free(&lb);
         return -1;
     }
     for (int j = 0; j < height; j++)
         for (int i = 0; i < width; i++) {
             lp_vec3 o, d;
             long k = (long)j * width + i;
-            rs_camera_ray(&view, i + 0.5, j + 0.5, width, height, &o, &d);
-            int lens = may_see_lens(s, &lb, o, d) && sees_lens(s, o, d);
+            int lens = 0;
+            if (may_project_lens(&lb, i, j)) {
+                rs_camera_ray(&view, i + 0.5, j + 0.5, width, height, &o, &d);
+                lens = may_see_lens(s, &lb, o, d) && sees_lens(s, o, d);
+            }
             int g = mark[k] ? G_MARKED : lens ? G_LENS : G_OTHER;
             group[k] = (unsigned char)g;
             count[g]++;
             ps->lens_share += lens ? 1.0 / (double)total : 0.0;
         }
-    free(lb.lens);
+    lens_boxes_free(&lb);
     /* A marked pixel (cell_pixel) stands for its pilot cell (at most what
      * there is); the other groups share the rest in proportion. */
     {

@@ -198,6 +198,48 @@ void rs_camera_ray(const rs_view *v, double px, double py, int width,
     *dir = v3_unit(d);
 }
 
+static double det3(lp_vec3 a, lp_vec3 b, lp_vec3 c)
+{
+    return v3_dot(a, v3_cross(b, c));
+}
+
+int rs_camera_box_pixels(const rs_view *v, int width, int height, lp_vec3 lo, lp_vec3 hi,
+                         int rect[4])
+{
+    double det = det3(v->R, v->U, v->D), xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY,
+           ymax = -INFINITY;
+    rect[0] = 0, rect[1] = width, rect[2] = 0, rect[3] = height;
+    if (!(fabs(det) > 0.0) || !isfinite(det))
+        return 0;
+    for (int c = 0; c < 8; c++) {
+        lp_vec3 p = v3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z);
+        lp_vec3 w = v3_sub(p, v->location);
+        /* w = a R + b U + s D (Cramer) */
+        double a = det3(w, v->U, v->D) / det, b = det3(v->R, w, v->D) / det;
+        if (!v->orthographic) {
+            double s = det3(v->R, v->U, w) / det;
+            if (!(s > 0.0))
+                return 0; /* on or behind the camera's plane */
+            a /= s;
+            b /= s;
+        }
+        /* x0 = a = px / width - 0.5, y0 = b = 0.5 - py / height */
+        double px = (a + 0.5) * width, py = (0.5 - b) * height;
+        if (!isfinite(px) || !isfinite(py))
+            return 0;
+        xmin = fmin(xmin, px), xmax = fmax(xmax, px);
+        ymin = fmin(ymin, py), ymax = fmax(ymax, py);
+    }
+    /* pixel i's ray is at px = i + 0.5 */
+    double i0 = floor(xmin - 0.5) - 1.0, i1 = ceil(xmax - 0.5) + 2.0;
+    double j0 = floor(ymin - 0.5) - 1.0, j1 = ceil(ymax - 0.5) + 2.0;
+    rect[0] = (int)fmax(0.0, fmin((double)width, i0));
+    rect[1] = (int)fmax(0.0, fmin((double)width, i1));
+    rect[2] = (int)fmax(0.0, fmin((double)height, j0));
+    rect[3] = (int)fmax(0.0, fmin((double)height, j1));
+    return 1;
+}
+
 void rs_camera_aperture_ray(const rs_view *v, double px, double py, int width,
                             int height, int k, lp_vec3 *origin, lp_vec3 *dir)
 {

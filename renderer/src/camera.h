@@ -110,4 +110,16 @@ void rs_camera_ray(const rs_view *v, double px, double py, int width,
 void rs_camera_aperture_ray(const rs_view *v, double px, double py, int width,
                             int height, int k, lp_vec3 *origin, lp_vec3 *dir);
 
+/* The pixels whose primary ray (rs_camera_ray) may meet the box lo..hi:
+ * the rectangle rect[0] <= i < rect[1], rect[2] <= j < rect[3] (perhaps
+ * empty) that holds the box's eight corners projected onto the image --
+ * through v->location, or along D for an orthographic camera: a ray
+ * meets a convex body only through its projection, the hull of the
+ * corners' -- widened by a pixel on every side for rounding.  Returns 1,
+ * or 0 when it cannot tell (a corner not in front of the camera, or the
+ * box or the projection not finite): then any pixel's ray may meet it
+ * and rect is the whole image.  Pure. */
+int rs_camera_box_pixels(const rs_view *v, int width, int height, lp_vec3 lo, lp_vec3 hi,
+                         int rect[4]);
+
 #endif

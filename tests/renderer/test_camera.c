@@ -15,6 +15,7 @@
 
 #include "camera.h"
 #include "check.h"
+#include "splitmix.h"
 #include "scene.h"
 
 #define TOL 1e-14
@@ -572,8 +573,124 @@ static void test_aperture(void)
     expect_error(&c, 320, 240, "negative blur_samples");
 }
 
+/* Does the ray o + t d, t >= 0, meet the box lo..hi?  (Slabs, written
+ * here for the test.) */
+static int ray_meets_box(lp_vec3 o, lp_vec3 d, lp_vec3 lo, lp_vec3 hi)
+{
+    double oo[3] = {o.x, o.y, o.z}, dd[3] = {d.x, d.y, d.z};
+    double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z}, t0 = 0.0, t1 = INFINITY;
+    for (int k = 0; k < 3; k++) {
+        if (dd[k] == 0.0) {
+            if (oo[k] < l[k] || oo[k] > h[k])
+                return 0;
+            continue;
+        }
+        double a = (l[k] - oo[k]) / dd[k], b = (h[k] - oo[k]) / dd[k];
+        t0 = fmax(t0, fmin(a, b));
+        t1 = fmin(t1, fmax(a, b));
+    }
+    return t0 <= t1;
+}
+
+/* rs_camera_box_pixels: every pixel whose primary ray meets a box lies in
+ * its rectangle, and the rectangle is no more than the bounding
+ * rectangle of those pixels and its margin (3 pixels a side: the margin's
+ * 1 and the pixel centres' rounding); a box not wholly in front of a
+ * perspective camera gives the whole image. */
+static void check_box_pixels(const rs_view *v, int w, int h, uint64_t *seed, const char *what)
+{
+    for (int n = 0; n < 40; n++) {
+        lp_vec3 c = v3(6.0 * splitmix_uniform(seed) - 3.0, 6.0 * splitmix_uniform(seed) - 3.0,
+                       6.0 * splitmix_uniform(seed) - 3.0);
+        lp_vec3 e = v3(0.05 + splitmix_uniform(seed), 0.05 + splitmix_uniform(seed),
+                       0.05 + splitmix_uniform(seed));
+        lp_vec3 lo = v3(c.x - e.x, c.y - e.y, c.z - e.z), hi = v3(c.x + e.x, c.y + e.y, c.z + e.z);
+        int r[4], known = rs_camera_box_pixels(v, w, h, lo, hi, r), hit = 0, missed = 0;
+        int bi0 = w, bi1 = -1, bj0 = h, bj1 = -1;
+        for (int j = 0; j < h; j++)
+            for (int i = 0; i < w; i++) {
+                lp_vec3 o, d;
+                rs_camera_ray(v, i + 0.5, j + 0.5, w, h, &o, &d);
+                if (!ray_meets_box(o, d, lo, hi))
+                    continue;
+                hit++;
+                bi0 = i < bi0 ? i : bi0, bi1 = i > bi1 ? i : bi1;
+                bj0 = j < bj0 ? j : bj0, bj1 = j > bj1 ? j : bj1;
+                if (!(i >= r[0] && i < r[1] && j >= r[2] && j < r[3]))
+                    missed++;
+            }
+        CHECK(missed == 0, "%s box %d: %d of %d pixels meeting it outside [%d,%d)x[%d,%d)", what,
+              n, missed, hit, r[0], r[1], r[2], r[3]);
+        if (!known) {
+            CHECK(r[0] == 0 && r[1] == w && r[2] == 0 && r[3] == h,
+                  "%s box %d: not known, the whole image", what, n);
+            continue;
+        }
+        if (hit == 0 || bi0 == 0 || bj0 == 0 || bi1 == w - 1 || bj1 == h - 1)
+            continue; /* empty, or cut by the image's edge */
+        CHECK(r[0] >= bi0 - 3 && r[1] <= bi1 + 4 && r[2] >= bj0 - 3 && r[3] <= bj1 + 4,
+              "%s box %d: [%d,%d)x[%d,%d) within 3 pixels of the pixels meeting it "
+              "[%d,%d]x[%d,%d]",
+              what, n, r[0], r[1], r[2], r[3], bi0, bi1, bj0, bj1);
+    }
+}
+
+static void test_box_pixels(void)
+{
+    rs_camera c = pov_default();
+    rs_view v;
+    uint64_t seed = 12345;
+    lp_vec3 lo = v3(-1, -1, -1), hi = v3(1, 1, 1);
+    int r[4];
+    c.location = v3(0, 1, -8);
+    c.look_at = v3(0, 0, 0);
+    c.has_look_at = 1;
+    c.right = v3(4.0 / 3.0, 0, 0);
+    c.angle = 50;
+    c.has_angle = 1;
+    CHECK(setup(&c, 64, 48, &v) == 0, "box pixels: perspective sets up");
+    check_box_pixels(&v, 64, 48, &seed, "perspective");
+    c.right = v3(-4.0 / 3.0, 0, 0);
+    CHECK(setup(&c, 64, 48, &v) == 0, "box pixels: mirrored sets up");
+    check_box_pixels(&v, 64, 48, &seed, "mirrored");
+    c.location = v3(5, 4, -3);
+    c.right = v3(4.0 / 3.0, 0, 0);
+    CHECK(setup(&c, 48, 64, &v) == 0, "box pixels: oblique sets up");
+    check_box_pixels(&v, 48, 64, &seed, "oblique");
+    /* the camera inside the box, or the box behind it: not known */
+    c.location = v3(0, 0, 0);
+    c.look_at = v3(0, 0, 5);
+    CHECK(setup(&c, 64, 48, &v) == 0, "box pixels: inside sets up");
+    CHECK(rs_camera_box_pixels(&v, 64, 48, lo, hi, r) == 0 && r[0] == 0 && r[1] == 64 &&
+              r[2] == 0 && r[3] == 48,
+          "the camera inside the box: the whole image");
+    CHECK(rs_camera_box_pixels(&v, 64, 48, v3(-1, -1, -5), v3(1, 1, -3), r) == 0,
+          "a box behind the camera: not known");
+    /* orthographic: projected along D */
+    c = pov_default();
+    c.orthographic = 1;
+    c.location = v3(0, 2, -10);
+    c.look_at = v3(0, 0, 0);
+    c.has_look_at = 1;
+    c.right = v3(8, 0, 0);
+    c.up = v3(0, 6, 0);
+    CHECK(setup(&c, 64, 48, &v) == 0, "box pixels: orthographic sets up");
+    check_box_pixels(&v, 64, 48, &seed, "orthographic");
+    /* a box off the image: an empty rectangle */
+    c = pov_default();
+    c.location = v3(0, 0, -5);
+    CHECK(setup(&c, 64, 48, &v) == 0, "box pixels: straight sets up");
+    CHECK(rs_camera_box_pixels(&v, 64, 48, v3(20, -1, -1), v3(22, 1, 1), r) == 1 &&
+              r[0] == r[1],
+          "a box far right of the view: no pixel [%d,%d)", r[0], r[1]);
+    lo = v3(NAN, 0, 0);
+    CHECK(rs_camera_box_pixels(&v, 64, 48, lo, hi, r) == 0 && r[1] == 64,
+          "a box with a NaN: not known, the whole image");
+}
+
 int main(void)
 {
+    test_box_pixels();
     test_scene_defaults();
     test_aperture();
     test_default();
