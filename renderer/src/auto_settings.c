@@ -163,10 +163,13 @@ static int sees_lens(const rs_scene *s, lp_vec3 o, lp_vec3 d)
 }
 
 /* The lenses' boxes, which a camera ray must meet to see a lens (a hit an
- * object reports lies in its box): testing them first spares the scene
- * intersections of the pixels that cannot see one, most of the image,
- * and changes no pixel's answer.  boxed 0: some lens has no box (or the
- * scene no tree), so every pixel is intersected. */
+ * object reports lies in its box): a pixel outside every box's projection
+ * onto the image (rect) makes no ray at all, and a ray is tested against
+ * the boxes before the scene is intersected -- sparing most of the image
+ * its ray or its intersections, and changing no pixel's answer.  A lens
+ * with no finite box projects onto the whole image; boxed 0: some lens
+ * has no box the tree tests (or the scene no tree), so every ray made is
+ * intersected. */
 typedef struct lens_boxes {
     int *lens;  /* the lenses' object indices */
     int *rect;  /* 4 per lens: the pixels whose ray may meet its box
