@@ -59,13 +59,6 @@ render() { # OUT.pfm ARGS...: a render, its line kept in $tmp/log
     }
 }
 
-rmse() { # A.pfm B.pfm
-    pfm_samples "$1" "$tmp/a.txt"
-    pfm_samples "$2" "$tmp/b.txt"
-    paste "$tmp/a.txt" "$tmp/b.txt" |
-        awk '{ d = $1 - $2; s += d * d; n++ } END { printf "%.3g\n", n ? sqrt(s / n) : 0 }'
-}
-
 over=0
 for s in "$@"; do
     [ -f "$s" ] || { echo "auto_check: no scene $s" >&2; exit 2; }
@@ -76,11 +69,11 @@ for s in "$@"; do
         [ -f "${f%%:*}" ] || render "${f%%:*}" "$s" --mode polarized --depth 32 --cutoff 1e-7 \
             --wavelengths "${f##*:}"
     done
-    U=$(rmse "$half" "$ref")
+    U=$(pfm_rmse "$half" "$ref" "$tmp")
     for E in $tols; do
         render "$tmp/auto.pfm" "$s" --mode auto --tolerance "$E"
         choice=$(sed -n 's/^lensrender: auto: \([^:]*\) for E = .*/\1/p' "$tmp/log")
-        e=$(rmse "$tmp/auto.pfm" "$ref")
+        e=$(pfm_rmse "$tmp/auto.pfm" "$ref" "$tmp")
         verdict=$(awk -v e="$e" -v u="$U" -v E="$E" \
             'BEGIN { v = "unresolved"; if (e + u <= E) v = "yes"; else if (e - u > E) v = "NO"; print v }')
         [ "$verdict" = NO ] && over=$((over + 1))

@@ -39,22 +39,14 @@ render() {
         --wavelengths "$3" ${5:-} --quiet -o "$tmp/x.png" --pfm "$4"
 }
 
-# The RMSE of two PFM files of one size.
-rmse() {
-    pfm_samples "$1" "$tmp/a.txt"
-    pfm_samples "$2" "$tmp/b.txt"
-    paste "$tmp/a.txt" "$tmp/b.txt" |
-        awk '{ d = $1 - $2; s += d * d; n++ } END { printf "%.3g", sqrt(s / n) }'
-}
-
 # one SCENE FLAG: the table's lines of a scene in one setting.
 one() {
     render "$new" "$1" "$REF" "$tmp/ref.pfm" "$2"
     for n in 4 8 16 32 64 128 256; do
         render "$old" "$1" "$n" "$tmp/old.pfm" "$2"
         render "$new" "$1" "$n" "$tmp/new.pfm" "$2"
-        a=$(rmse "$tmp/old.pfm" "$tmp/ref.pfm")
-        b=$(rmse "$tmp/new.pfm" "$tmp/ref.pfm")
+        a=$(pfm_rmse "$tmp/old.pfm" "$tmp/ref.pfm" "$tmp")
+        b=$(pfm_rmse "$tmp/new.pfm" "$tmp/ref.pfm" "$tmp")
         printf '%-15s %-15s %6d %10s %10s %8s\n' "$1" "${2:-dispersion}" "$n" "$a" "$b" \
             "$(awk -v a="$a" -v b="$b" 'BEGIN { if (b > 0) printf "%.1f", a / b; else print "-" }')"
     done

@@ -594,9 +594,12 @@ static int ray_meets_box(lp_vec3 o, lp_vec3 d, lp_vec3 lo, lp_vec3 hi)
 
 /* rs_camera_box_pixels: every pixel whose primary ray meets a box lies in
  * its rectangle, and the rectangle is no more than the bounding
- * rectangle of those pixels and its margin (3 pixels a side: the margin's
- * 1 and the pixel centres' rounding); a box not wholly in front of a
- * perspective camera gives the whole image. */
+ * rectangle of those pixels and 3 pixels a side: the margin's 1, 1 more
+ * where the projected extreme falls between two pixel centres, and 1
+ * more where the hull's extreme corner is a spike no pixel centre lies
+ * in.  Measured on the 99 boxes below that fall wholly in the image: 1
+ * on 5 of their 396 sides, 2 on 383, 3 on 8.  A box not wholly in front
+ * of a perspective camera gives the whole image. */
 static void check_box_pixels(const rs_view *v, int w, int h, uint64_t *seed, const char *what)
 {
     for (int n = 0; n < 40; n++) {
